@@ -1,0 +1,95 @@
+// Coarse binary cubes of a reference scan (paper section 2.1, eqs. 3-6).
+//
+// The grid spans the axis-aligned bounding box of the reference points. A point's integer grid
+// coordinates are I_k = round((k - k_min) / E) for k in {x, y, z} (eq. 6), and its linear index
+// is I = Ix + Iy*Nx + Iz*Nx*Ny (eq. 5). Erratum: with round(), Ix runs 0..Ixmax *inclusive*, so
+// there are Nx = Ixmax + 1 cubes along x (eq. 3 writes v = Ixmax*Iymax*Izmax; here
+// v = Nx*Ny*Nz). V holds one bit per cube; L lists the indices of the set cubes (l = |L|).
+#pragma once
+
+#include <cstdint>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "cube_scan_matcher/core/point_array.h"
+
+namespace cube_scan_matcher {
+
+struct CubeGridSettings {
+  double cube_edge = 0.5;  ///< E [m], in (0, 100]. The paper recommends 0.3-0.5 m.
+  /// Memory guard: largest allowed v = Nx*Ny*Nz [cubes = bits], in [1, 2^31]. The default
+  /// 2^31 bits is 256 MiB; a larger grid (absurd extent or tiny E) is refused with an error.
+  std::uint64_t max_cubes = std::uint64_t{1} << 31;
+};
+
+/// Throws std::invalid_argument naming the bad setting.
+void validate(const CubeGridSettings& settings);
+
+/// Why a grid could not be built.
+class CubeGridError : public std::runtime_error {
+ public:
+  enum class Code { EmptyReference, NonFiniteReference, TooManyCubes };
+  CubeGridError(Code code, const std::string& what) : std::runtime_error(what), code_(code) {}
+  Code code() const { return code_; }
+
+ private:
+  Code code_;
+};
+
+/// Affine map from a point (metres) to continuous grid coordinates plus 0.5, so that
+/// floor(A p + b) = round((R p + t - min) / E): one multiply-add chain per axis in the hot loop.
+struct GridAffine {
+  float a[3][3];
+  float b[3];
+};
+
+class CubeGrid {
+ public:
+  CubeGrid() = default;
+
+  /// Builds V and L from the reference points (which must be finite: filter them first).
+  /// Throws CubeGridError (empty input, non-finite point, v above settings.max_cubes).
+  static CubeGrid build(const PointArray& reference, const CubeGridSettings& settings);
+
+  double edge() const { return edge_; }
+  const Eigen::Vector3d& minCorner() const { return min_; }
+  const Eigen::Vector3d& maxCorner() const { return max_; }
+  /// Cubes per axis (Ixmax + 1, ...).
+  const Eigen::Vector3i& dims() const { return dims_; }
+  /// v: number of cubes (bits of V).
+  std::uint64_t cubeCount() const { return std::uint64_t(dims_.x()) * dims_.y() * dims_.z(); }
+  /// l: number of set cubes (length of L).
+  std::size_t occupiedCount() const { return list_.size(); }
+
+  /// Linear index (eq. 5) of the cube holding p = R q + t, or -1 if outside the grid.
+  std::int64_t index(const Eigen::Vector3f& p) const;
+  bool occupied(std::int64_t index) const {
+    return index >= 0 && ((bits_[std::size_t(index) >> 6] >> (index & 63)) & 1u);
+  }
+  const std::vector<std::uint64_t>& bits() const { return bits_; }
+  const std::vector<std::int32_t>& list() const { return list_; }
+
+  /// The map used by the objective for a candidate rotation R and translation t (float).
+  GridAffine affine(const Eigen::Matrix3f& rotation, const Eigen::Vector3f& translation) const;
+  /// Grid extent as floats for the in-grid test 0 <= a < N.
+  const Eigen::Vector3f& dimsF() const { return dims_f_; }
+
+ private:
+  double edge_ = 0.0;
+  Eigen::Vector3d min_ = Eigen::Vector3d::Zero();
+  Eigen::Vector3d max_ = Eigen::Vector3d::Zero();
+  Eigen::Vector3i dims_ = Eigen::Vector3i::Zero();
+  Eigen::Vector3f dims_f_ = Eigen::Vector3f::Zero();
+  std::vector<std::uint64_t> bits_;  ///< V, 64 cubes per word.
+  std::vector<std::int32_t> list_;   ///< L, unsorted indices of set cubes.
+};
+
+/// Eq. (5)-(6) for a block of points: idx[i] = linear index of A p_i + b, or -1 outside the
+/// grid. The per-point loop of the method: contiguous floats in, int32 out, vectorised.
+void computeCubeIndices(const GridAffine& affine, const Eigen::Vector3f& dims, const float* x,
+                        const float* y, const float* z, std::size_t n, std::int32_t* idx);
+
+}  // namespace cube_scan_matcher

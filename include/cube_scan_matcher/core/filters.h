@@ -1,0 +1,39 @@
+// Input filtering (paper section 3.2: no-return and max-range readings are not used).
+#pragma once
+
+#include <cstddef>
+
+#include <Eigen/Core>
+
+#include "cube_scan_matcher/core/point_array.h"
+
+namespace cube_scan_matcher {
+
+struct RangeFilterSettings {
+  double min_range = 0.0;    ///< [m] points closer than this to `origin` are dropped (>= 0).
+  double max_range = 1e9;    ///< [m] points farther than this are dropped (> min_range).
+  Eigen::Vector3d origin = Eigen::Vector3d::Zero();  ///< [m] sensor origin in the cloud frame.
+};
+
+/// What the filter kept and why it dropped the rest.
+struct FilterStats {
+  std::size_t input = 0;
+  std::size_t non_finite = 0;    ///< NaN or inf in any coordinate.
+  std::size_t out_of_range = 0;  ///< outside [min_range, max_range].
+  std::size_t kept = 0;
+};
+
+/// Throws std::invalid_argument naming the bad setting.
+void validate(const RangeFilterSettings& settings);
+
+/// Appends the finite points of (x, y, z) within range to `out`. Works on any strided source,
+/// so ROS and PCL adapters need not copy first. `stride` is in floats.
+FilterStats appendFiltered(const float* x, const float* y, const float* z, std::size_t count,
+                           std::size_t stride, const RangeFilterSettings& settings,
+                           PointArray& out);
+
+/// Filters a PointArray (convenience over appendFiltered).
+PointArray filterPoints(const PointArray& in, const RangeFilterSettings& settings,
+                        FilterStats* stats = nullptr);
+
+}  // namespace cube_scan_matcher

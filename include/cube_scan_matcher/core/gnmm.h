@@ -1,0 +1,69 @@
+// Globalized Nelder-Mead method (paper section 2.3): a Nelder-Mead search over a population of
+// N >= 7 vertices in 6-D that, where plain Nelder-Mead would shrink the simplex, keeps the best
+// vertex and restarts all others at random around the initial estimate. It maximises any
+// function of a 6-vector and knows nothing about points or cubes.
+#pragma once
+
+#include <cstdint>
+#include <functional>
+#include <string>
+#include <vector>
+
+#include <Eigen/Core>
+
+namespace cube_scan_matcher {
+
+using Vector6d = Eigen::Matrix<double, 6, 1>;
+
+struct GnmmSettings {
+  int vertices = 15;          ///< N, population size, in [7, 1000] (paper: 15).
+  int max_iterations = 500;   ///< Nelder-Mead iterations, in [1, 1e6] (paper: 500).
+  /// Restart half-widths around the initial estimate, per parameter, all > 0. For poses:
+  /// [m, m, m, rad, rad, rad]; the paper's default is +-1 m, +-8 deg.
+  Vector6d bounds = (Vector6d() << 1.0, 1.0, 1.0, 0.13962634015954636, 0.13962634015954636,
+                     0.13962634015954636).finished();
+  double reflection = 1.0;    ///< alpha > 0.
+  double expansion = 2.0;     ///< gamma > 1.
+  double contraction = 0.5;   ///< rho in (0, 1).
+  /// Stop when the best value has not improved for this many iterations; 0 = never (paper).
+  int stall_iterations = 0;
+  /// Restarts draw vertices around the initial estimate within `bounds` (paper). Values < 1
+  /// shrink the restart box around the *best* vertex instead, by this factor per restart
+  /// (beyond the paper; 1 = paper). In (0, 1].
+  double restart_shrink = 1.0;
+  std::uint64_t seed = 42;    ///< RNG seed: equal seeds give equal runs.
+};
+
+/// Throws std::invalid_argument naming the bad setting.
+void validate(const GnmmSettings& settings);
+
+enum class GnmmStop { MaxIterations, Stalled };
+std::string toString(GnmmStop stop);
+
+struct GnmmResult {
+  Vector6d best = Vector6d::Zero();
+  double best_value = 0.0;
+  double initial_value = 0.0;  ///< f at the initial estimate (vertex 0 of the population).
+  int evaluations = 0;
+  int iterations = 0;
+  int restarts = 0;
+  GnmmStop stop = GnmmStop::MaxIterations;
+  std::vector<Vector6d> vertices;  ///< final population
+  std::vector<double> values;      ///< f at each final vertex
+};
+
+class Gnmm {
+ public:
+  using Objective = std::function<double(const Vector6d&)>;
+
+  explicit Gnmm(const GnmmSettings& settings);  // validates
+
+  /// Maximises f starting from `initial`. The population is the initial estimate plus N-1
+  /// vertices drawn uniformly within +-bounds around it.
+  GnmmResult maximize(const Objective& f, const Vector6d& initial) const;
+
+ private:
+  GnmmSettings settings_;
+};
+
+}  // namespace cube_scan_matcher

@@ -1,0 +1,35 @@
+// Six-parameter pose of the paper (eq. 2) and its conversions.
+//
+// Convention: a pose is [x0, y0, z0, roll α, pitch β, yaw γ] in metres and radians. It maps a
+// point p* of the second (newer) scan into the frame of the first (reference) scan as
+//   p = t + R p*,   R = Rz(γ) Ry(β) Rx(α)                                    (paper eq. 2)
+// i.e. roll about X is applied first, then pitch about Y, then yaw about Z (fixed axes).
+#pragma once
+
+#include <Eigen/Core>
+#include <Eigen/Geometry>
+
+namespace cube_scan_matcher {
+
+/// [x, y, z, roll, pitch, yaw]: metres and radians.
+using Pose6 = Eigen::Matrix<double, 6, 1>;
+
+/// Rotation of eq. (2): Rz(yaw) * Ry(pitch) * Rx(roll), written out as in the paper.
+Eigen::Matrix3d rotationFromRpy(double roll, double pitch, double yaw);
+
+/// Rigid transform T (p = T p*) for a pose of eq. (2).
+Eigen::Isometry3d poseToIsometry(const Pose6& pose);
+
+/// Inverse of poseToIsometry. Pitch is returned in [-pi/2, pi/2]; at the gimbal lock
+/// (|pitch| = 90 deg) roll is set to 0 and yaw absorbs the rest.
+Pose6 isometryToPose(const Eigen::Isometry3d& transform);
+
+/// Wraps an angle to (-pi, pi].
+double wrapAngle(double angle);
+
+/// Degrees to radians.
+constexpr double deg2rad(double deg) { return deg * 0.017453292519943295; }
+/// Radians to degrees.
+constexpr double rad2deg(double rad) { return rad * 57.29577951308232; }
+
+}  // namespace cube_scan_matcher

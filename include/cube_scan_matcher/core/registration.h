@@ -1,0 +1,85 @@
+// Scan registration by coincidence of coarse binary cubes, optimised with GNMM: the ROS-free
+// front end. Settings in, result out; the grid of the reference is built once per reference.
+#pragma once
+
+#include <cstddef>
+#include <string>
+
+#include <Eigen/Geometry>
+
+#include "cube_scan_matcher/core/cube_grid.h"
+#include "cube_scan_matcher/core/gnmm.h"
+#include "cube_scan_matcher/core/point_array.h"
+#include "cube_scan_matcher/core/pose.h"
+
+namespace cube_scan_matcher {
+
+struct RegistrationSettings {
+  CubeGridSettings grid;  ///< E and the memory cap.
+  GnmmSettings gnmm;      ///< population, iterations, restart bounds, seed.
+  /// Beyond the paper: before the search, keep one scan point per voxel of edge
+  /// collapse_fraction * E. 0 = off, every point is evaluated (paper). In [0, 1].
+  double collapse_fraction = 0.0;
+
+  /// The paper's fixed mode: 15 vertices, 500 iterations, all points, restarts around the
+  /// initial estimate within +-1 m / +-8 deg.
+  static RegistrationSettings paper(double cube_edge = 0.5);
+};
+
+/// Throws std::invalid_argument naming the bad setting.
+void validate(const RegistrationSettings& settings);
+
+enum class RegistrationStatus {
+  Ok,           ///< J > 0 at the result.
+  NoReference,  ///< align() before setReference().
+  EmptyScan,    ///< the scan has no point.
+  NoOverlap,    ///< no scan point fell in a set cube at any evaluated pose (J = 0).
+};
+std::string toString(RegistrationStatus status);
+
+struct RegistrationResult {
+  RegistrationStatus status = RegistrationStatus::NoReference;
+  Pose6 pose = Pose6::Zero();  ///< [m, m, m, rad, rad, rad]: scan -> reference (eq. 2).
+  Eigen::Isometry3d transform = Eigen::Isometry3d::Identity();  ///< same pose as a matrix.
+  int J = 0;                      ///< coincident cubes at the result.
+  int J_guess = 0;                ///< coincident cubes at the initial estimate.
+  std::size_t reference_cubes = 0;  ///< l: set cubes of the reference.
+  std::size_t points_in = 0;      ///< scan points given.
+  std::size_t points_used = 0;    ///< scan points evaluated (after collapsing).
+  int evaluations = 0;
+  int iterations = 0;
+  int restarts = 0;
+  GnmmStop stop = GnmmStop::MaxIterations;  ///< why the search stopped.
+  double time_s = 0.0;            ///< wall time of align() [s].
+  std::string message;            ///< human-readable summary or reason of failure.
+
+  bool ok() const { return status == RegistrationStatus::Ok; }
+  /// J / l: fraction of the reference cubes matched, in [0, 1].
+  double overlap() const { return reference_cubes ? double(J) / double(reference_cubes) : 0.0; }
+};
+
+class CubeRegistration {
+ public:
+  explicit CubeRegistration(const RegistrationSettings& settings);  // validates
+
+  /// Builds V and L of the reference (finite points; see filters.h). Throws CubeGridError;
+  /// on error the previous reference is kept.
+  void setReference(const PointArray& reference);
+  bool hasReference() const { return has_reference_; }
+  const CubeGrid& grid() const { return grid_; }
+
+  /// Registers `scan` to the reference around `guess` (scan -> reference).
+  RegistrationResult align(const PointArray& scan, const Pose6& guess) const;
+
+  const RegistrationSettings& settings() const { return settings_; }
+  /// Takes effect at the next setReference()/align(); validates. A new cube_edge or max_cubes
+  /// needs a new setReference() (the grid is rebuilt only there).
+  void setSettings(const RegistrationSettings& settings);
+
+ private:
+  RegistrationSettings settings_;
+  CubeGrid grid_;
+  bool has_reference_ = false;
+};
+
+}  // namespace cube_scan_matcher

@@ -1,0 +1,56 @@
+#include "cube_scan_matcher/core/filters.h"
+
+#include <cmath>
+#include <stdexcept>
+#include <string>
+
+namespace cube_scan_matcher {
+
+void validate(const RangeFilterSettings& s) {
+  if (!(s.min_range >= 0.0) || !std::isfinite(s.min_range)) {
+    throw std::invalid_argument("min_range must be finite and >= 0 m, got " +
+                                std::to_string(s.min_range));
+  }
+  if (!(s.max_range > s.min_range)) {
+    throw std::invalid_argument("max_range (" + std::to_string(s.max_range) +
+                                " m) must be greater than min_range (" +
+                                std::to_string(s.min_range) + " m)");
+  }
+  if (!s.origin.allFinite()) throw std::invalid_argument("filter origin must be finite");
+}
+
+FilterStats appendFiltered(const float* x, const float* y, const float* z, std::size_t count,
+                           std::size_t stride, const RangeFilterSettings& s, PointArray& out) {
+  FilterStats st;
+  st.input = count;
+  const double min2 = s.min_range * s.min_range;
+  const double max2 = s.max_range * s.max_range;
+  out.reserve(out.size() + count);
+  for (std::size_t i = 0; i < count; ++i) {
+    const float px = x[i * stride], py = y[i * stride], pz = z[i * stride];
+    if (!std::isfinite(px) || !std::isfinite(py) || !std::isfinite(pz)) {
+      ++st.non_finite;
+      continue;
+    }
+    const double dx = px - s.origin.x(), dy = py - s.origin.y(), dz = pz - s.origin.z();
+    const double r2 = dx * dx + dy * dy + dz * dz;
+    if (r2 < min2 || r2 > max2) {
+      ++st.out_of_range;
+      continue;
+    }
+    out.push_back(px, py, pz);
+    ++st.kept;
+  }
+  return st;
+}
+
+PointArray filterPoints(const PointArray& in, const RangeFilterSettings& settings,
+                        FilterStats* stats) {
+  PointArray out;
+  FilterStats st = appendFiltered(in.x.data(), in.y.data(), in.z.data(), in.size(), 1, settings,
+                                  out);
+  if (stats) *stats = st;
+  return out;
+}
+
+}  // namespace cube_scan_matcher

@@ -1,0 +1,137 @@
+#include "cube_scan_matcher/core/gnmm.h"
+
+#include <algorithm>
+#include <cmath>
+#include <random>
+#include <stdexcept>
+
+namespace cube_scan_matcher {
+
+void validate(const GnmmSettings& s) {
+  auto fail = [](const std::string& what) { throw std::invalid_argument(what); };
+  if (s.vertices < 7 || s.vertices > 1000)
+    fail("vertices must be in [7, 1000] (a 6-D simplex needs 7), got " + std::to_string(s.vertices));
+  if (s.max_iterations < 1 || s.max_iterations > 1000000)
+    fail("max_iterations must be in [1, 1000000], got " + std::to_string(s.max_iterations));
+  if (!((s.bounds.array() > 0.0).all() && s.bounds.allFinite()))
+    fail("restart bounds must all be finite and > 0");
+  if (!(s.reflection > 0.0)) fail("reflection must be > 0");
+  if (!(s.expansion > 1.0)) fail("expansion must be > 1");
+  if (!(s.contraction > 0.0 && s.contraction < 1.0)) fail("contraction must be in (0, 1)");
+  if (s.stall_iterations < 0) fail("stall_iterations must be >= 0");
+  if (!(s.restart_shrink > 0.0 && s.restart_shrink <= 1.0)) fail("restart_shrink must be in (0, 1]");
+}
+
+std::string toString(GnmmStop stop) {
+  switch (stop) {
+    case GnmmStop::MaxIterations: return "max_iterations";
+    case GnmmStop::Stalled: return "stalled";
+  }
+  return "unknown";
+}
+
+Gnmm::Gnmm(const GnmmSettings& settings) : settings_(settings) { validate(settings_); }
+
+GnmmResult Gnmm::maximize(const Objective& f, const Vector6d& initial) const {
+  const GnmmSettings& s = settings_;
+  const int n = s.vertices;
+  std::mt19937_64 rng(s.seed);
+  std::uniform_real_distribution<double> unit(-1.0, 1.0);
+  GnmmResult r;
+  auto eval = [&](const Vector6d& x) {
+    ++r.evaluations;
+    return f(x);
+  };
+  auto draw = [&](const Vector6d& center, const Vector6d& half) {
+    Vector6d x;
+    for (int k = 0; k < 6; ++k) x[k] = center[k] + half[k] * unit(rng);
+    return x;
+  };
+
+  std::vector<Vector6d> x(n);
+  std::vector<double> fx(n);
+  x[0] = initial;
+  fx[0] = eval(initial);
+  r.initial_value = fx[0];
+  for (int i = 1; i < n; ++i) {
+    x[i] = draw(initial, s.bounds);
+    fx[i] = eval(x[i]);
+  }
+  Vector6d restart_half = s.bounds;
+
+  double best_ever = *std::max_element(fx.begin(), fx.end());
+  int last_improvement = 0;
+  for (r.iterations = 0; r.iterations < s.max_iterations;) {
+    ++r.iterations;
+    // Worst (lowest f), second worst and best vertex.
+    int worst = 0, best = 0;
+    for (int i = 1; i < n; ++i) {
+      if (fx[i] < fx[worst]) worst = i;
+      if (fx[i] > fx[best]) best = i;
+    }
+    int second = worst == 0 ? 1 : 0;
+    for (int i = 0; i < n; ++i) {
+      if (i != worst && fx[i] < fx[second]) second = i;
+    }
+    // Centroid of all vertices but the worst.
+    Vector6d c = Vector6d::Zero();
+    for (int i = 0; i < n; ++i) {
+      if (i != worst) c += x[i];
+    }
+    c /= double(n - 1);
+
+    const Vector6d xr = c + s.reflection * (c - x[worst]);
+    const double fr = eval(xr);
+    if (fr > fx[best]) {
+      const Vector6d xe = c + s.expansion * (xr - c);
+      const double fe = eval(xe);
+      if (fe > fr) {
+        x[worst] = xe;
+        fx[worst] = fe;
+      } else {
+        x[worst] = xr;
+        fx[worst] = fr;
+      }
+    } else if (fr > fx[second]) {
+      x[worst] = xr;
+      fx[worst] = fr;
+    } else {
+      // Outside contraction if the reflection beat the worst vertex, inside otherwise.
+      const bool outside = fr > fx[worst];
+      const Vector6d xc = outside ? Vector6d(c + s.contraction * (xr - c))
+                                  : Vector6d(c + s.contraction * (x[worst] - c));
+      const double fc = eval(xc);
+      if (fc > std::max(fr, fx[worst])) {
+        x[worst] = xc;
+        fx[worst] = fc;
+      } else {
+        // Where Nelder-Mead would shrink towards the best vertex, GNMM keeps the best vertex
+        // and restarts all others at random around the initial estimate.
+        ++r.restarts;
+        const Vector6d center = s.restart_shrink < 1.0 ? x[best] : initial;
+        if (s.restart_shrink < 1.0) restart_half *= s.restart_shrink;
+        for (int i = 0; i < n; ++i) {
+          if (i == best) continue;
+          x[i] = draw(center, restart_half);
+          fx[i] = eval(x[i]);
+        }
+      }
+    }
+    const double top = *std::max_element(fx.begin(), fx.end());
+    if (top > best_ever) {
+      best_ever = top;
+      last_improvement = r.iterations;
+    } else if (s.stall_iterations > 0 && r.iterations - last_improvement >= s.stall_iterations) {
+      r.stop = GnmmStop::Stalled;
+      break;
+    }
+  }
+  const int best = int(std::max_element(fx.begin(), fx.end()) - fx.begin());
+  r.best = x[best];
+  r.best_value = fx[best];
+  r.vertices = std::move(x);
+  r.values = std::move(fx);
+  return r;
+}
+
+}  // namespace cube_scan_matcher

@@ -1,0 +1,100 @@
+#include "cube_scan_matcher/core/registration.h"
+
+#include <chrono>
+#include <sstream>
+#include <stdexcept>
+
+#include "cube_scan_matcher/core/coincidence_objective.h"
+#include "cube_scan_matcher/core/voxel_collapse.h"
+
+namespace cube_scan_matcher {
+
+RegistrationSettings RegistrationSettings::paper(double cube_edge) {
+  RegistrationSettings s;
+  s.grid.cube_edge = cube_edge;
+  s.gnmm = GnmmSettings{};
+  s.collapse_fraction = 0.0;
+  return s;
+}
+
+void validate(const RegistrationSettings& s) {
+  validate(s.grid);
+  validate(s.gnmm);
+  if (!(s.collapse_fraction >= 0.0 && s.collapse_fraction <= 1.0)) {
+    throw std::invalid_argument("collapse_fraction must be in [0, 1], got " +
+                                std::to_string(s.collapse_fraction));
+  }
+}
+
+std::string toString(RegistrationStatus status) {
+  switch (status) {
+    case RegistrationStatus::Ok: return "ok";
+    case RegistrationStatus::NoReference: return "no_reference";
+    case RegistrationStatus::EmptyScan: return "empty_scan";
+    case RegistrationStatus::NoOverlap: return "no_overlap";
+  }
+  return "unknown";
+}
+
+CubeRegistration::CubeRegistration(const RegistrationSettings& settings) : settings_(settings) {
+  validate(settings_);
+}
+
+void CubeRegistration::setSettings(const RegistrationSettings& settings) {
+  validate(settings);
+  settings_ = settings;
+}
+
+void CubeRegistration::setReference(const PointArray& reference) {
+  grid_ = CubeGrid::build(reference, settings_.grid);  // throws before touching grid_
+  has_reference_ = true;
+}
+
+RegistrationResult CubeRegistration::align(const PointArray& scan, const Pose6& guess) const {
+  const auto start = std::chrono::steady_clock::now();
+  RegistrationResult res;
+  res.points_in = scan.size();
+  res.pose = guess;
+  res.transform = poseToIsometry(guess);
+  auto finish = [&](RegistrationStatus status, const std::string& msg) {
+    res.status = status;
+    res.message = msg;
+    res.time_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    return res;
+  };
+  if (!has_reference_) return finish(RegistrationStatus::NoReference, "no reference scan set");
+  res.reference_cubes = grid_.occupiedCount();
+  if (scan.empty()) return finish(RegistrationStatus::EmptyScan, "scan has no valid point");
+
+  PointArray collapsed;
+  const PointArray* points = &scan;
+  if (settings_.collapse_fraction > 0.0) {
+    collapsed = collapseToVoxels(scan, settings_.collapse_fraction * grid_.edge());
+    points = &collapsed;
+  }
+  res.points_used = points->size();
+
+  CoincidenceObjective objective(grid_, *points);
+  const Gnmm gnmm(settings_.gnmm);
+  const GnmmResult g =
+      gnmm.maximize([&objective](const Vector6d& p) { return double(objective(p)); }, guess);
+  res.pose = g.best;
+  for (int k = 3; k < 6; ++k) res.pose[k] = wrapAngle(res.pose[k]);
+  res.transform = poseToIsometry(res.pose);
+  res.J = int(g.best_value);
+  res.J_guess = int(g.initial_value);
+  res.evaluations = g.evaluations;
+  res.iterations = g.iterations;
+  res.restarts = g.restarts;
+  res.stop = g.stop;
+  if (res.J == 0) {
+    return finish(RegistrationStatus::NoOverlap,
+                  "no scan point fell in a reference cube at any tried pose (no overlap)");
+  }
+  std::ostringstream os;
+  os << "J = " << res.J << " of l = " << res.reference_cubes << " (J at guess " << res.J_guess
+     << "), " << res.evaluations << " evaluations, stopped: " << toString(g.stop);
+  return finish(RegistrationStatus::Ok, os.str());
+}
+
+}  // namespace cube_scan_matcher

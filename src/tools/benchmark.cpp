@@ -1,0 +1,302 @@
+// benchmark DATASET_DIR [options]
+// The paper's protocol (section 3.3) on a folder of real pairs: for each pair and each of N
+// seeded trials, the initial guess is the reference pose plus uniform errors within the chosen
+// bounds; the cube method and the PCL peers run in this process on the same guesses.
+#include <algorithm>
+#include <chrono>
+#include <cstdio>
+#include <fstream>
+#include <functional>
+#include <iostream>
+#include <map>
+#include <random>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "cloud_io.h"
+#include "cube_scan_matcher/core/filters.h"
+#include "cube_scan_matcher/core/registration.h"
+#include "dataset.h"
+#include "peer_methods.h"
+#include "settings_cli.h"
+
+using namespace cube_scan_matcher;
+using namespace cube_scan_matcher::tools;
+
+namespace {
+
+const std::vector<std::string> kAllMethods = {"cubes",   "cubes-paper", "icp-raw",   "icp-voxel",
+                                              "ndt-raw", "ndt-voxel",   "gicp-voxel"};
+
+void usage(std::ostream& os) {
+  os << "usage: benchmark DATASET_DIR [options]\n"
+        "Runs the paper's protocol on DATASET_DIR/pairs.txt (format: shared/data/README.md).\n\n"
+        "  --trials N            seeded trials per pair and bounds (default 25)\n"
+        "  --initial-errors B    big (+-1 m, +-8 deg), small (+-0.25 m, +-2 deg) or both\n"
+        "                        (default big)\n"
+        "  --methods LIST        comma list of: cubes (package defaults), cubes-paper (the\n"
+        "                        paper's fixed mode), icp-raw, icp-voxel, ndt-raw, ndt-voxel,\n"
+        "                        gicp-voxel; or 'all' (default all)\n"
+        "  --edges LIST          cube edges E [m] for the cube methods (default 0.5)\n"
+        "  --voxel L             voxel leaf of the *-voxel peer copies [m] (default 0.2)\n"
+        "  --trial-seed N        seed of the initial-guess errors (default 1)\n"
+        "  --csv FILE            per-trial rows (default benchmark.csv)\n"
+        "  --require-success K   exit 3 unless every cube method succeeds (Es < 0.10 m and\n"
+        "                        Ea < 1 deg) in at least K trials of every pair (default off)\n"
+        "Options of the 'cubes' method (cubes-paper ignores all but --edges/--seed/--max-cubes):\n"
+     << algorithmOptionsHelp() << "  -h, --help            this text\n";
+}
+
+std::vector<std::string> splitList(const std::string& s) {
+  std::vector<std::string> out;
+  std::stringstream ss(s);
+  for (std::string item; std::getline(ss, item, ',');) {
+    if (!item.empty()) out.push_back(item);
+  }
+  return out;
+}
+
+double median(std::vector<double> v) {
+  if (v.empty()) return 0.0;
+  std::sort(v.begin(), v.end());
+  const std::size_t m = v.size() / 2;
+  return v.size() % 2 ? v[m] : 0.5 * (v[m - 1] + v[m]);
+}
+
+struct Row {
+  std::string pair, bounds, method;
+  int trial;
+  double es, ea, time;
+  long evaluations;
+  long j, j_ref;
+};
+
+struct Bounds {
+  std::string name;
+  double t_m, a_deg;
+};
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  std::vector<std::string> args(argv + 1, argv + argc);
+  RegistrationSettings cube_settings = tools::defaultSettings();
+  RangeFilterSettings filter;
+  std::string dir, csv_path = "benchmark.csv";
+  int trials = 25, require = -1;
+  unsigned trial_seed = 1;
+  double voxel = 0.2;
+  std::vector<std::string> methods = kAllMethods;
+  std::vector<double> edges;
+  std::vector<Bounds> bounds = {{"big", 1.0, 8.0}};
+  try {
+    for (std::size_t i = 0; i < args.size();) {
+      const std::string& a = args[i];
+      auto next = [&]() -> std::string {
+        if (i + 1 >= args.size()) throw std::invalid_argument(a + ": missing value");
+        i += 2;
+        return args[i - 1];
+      };
+      if (a == "-h" || a == "--help") {
+        usage(std::cout);
+        return 0;
+      }
+      if (parseAlgorithmOption(args, i, cube_settings, filter)) continue;
+      if (a == "--trials") {
+        trials = int(parseNumber(a, next()));
+      } else if (a == "--initial-errors") {
+        const std::string b = next();
+        if (b == "big") bounds = {{"big", 1.0, 8.0}};
+        else if (b == "small") bounds = {{"small", 0.25, 2.0}};
+        else if (b == "both") bounds = {{"big", 1.0, 8.0}, {"small", 0.25, 2.0}};
+        else throw std::invalid_argument("--initial-errors: expected big, small or both");
+      } else if (a == "--methods") {
+        const std::string m = next();
+        methods = m == "all" ? kAllMethods : splitList(m);
+        for (const auto& name : methods) {
+          if (std::find(kAllMethods.begin(), kAllMethods.end(), name) == kAllMethods.end())
+            throw std::invalid_argument("--methods: unknown method '" + name + "'");
+        }
+      } else if (a == "--edges") {
+        edges.clear();
+        for (const auto& e : splitList(next())) edges.push_back(parseNumber("--edges", e));
+      } else if (a == "--voxel") {
+        voxel = parseNumber(a, next());
+      } else if (a == "--trial-seed") {
+        trial_seed = unsigned(parseNumber(a, next()));
+      } else if (a == "--csv") {
+        csv_path = next();
+      } else if (a == "--require-success") {
+        require = int(parseNumber(a, next()));
+      } else if (a.rfind("--", 0) == 0) {
+        throw std::invalid_argument("unknown option " + a);
+      } else {
+        if (!dir.empty()) throw std::invalid_argument("more than one DATASET_DIR given");
+        dir = args[i++];
+      }
+    }
+    if (dir.empty()) {
+      usage(std::cerr);
+      return 2;
+    }
+    if (trials < 1) throw std::invalid_argument("--trials must be >= 1");
+    if (!(voxel > 0.0)) throw std::invalid_argument("--voxel must be > 0");
+    if (edges.empty()) edges.push_back(cube_settings.grid.cube_edge);
+    validate(filter);
+
+    // The method table: name -> runner(pair data, guess) filling a Row.
+    struct Data {
+      Cloud::Ptr src, tgt, src_vox, tgt_vox;
+      PointArray src_pts, tgt_pts;
+      Eigen::Isometry3d ref;
+    };
+    using Runner = std::function<void(const Data&, const Eigen::Isometry3d&, Row&,
+                                      Eigen::Isometry3d&)>;
+    std::vector<std::pair<std::string, Runner>> table;
+    auto addCube = [&](const std::string& label, RegistrationSettings s) {
+      validate(s);
+      table.emplace_back(label, [s](const Data& d, const Eigen::Isometry3d& guess, Row& row,
+                                    Eigen::Isometry3d& est) {
+        const auto t0 = std::chrono::steady_clock::now();
+        CubeRegistration reg(s);
+        reg.setReference(d.tgt_pts);  // timed: the grid is part of the method's cost
+        const RegistrationResult r = reg.align(d.src_pts, isometryToPose(guess));
+        row.time = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+        est = r.transform;
+        row.evaluations = r.evaluations;
+        row.j = r.J;
+        // J at the reference pose, for comparison (untimed).
+        CubeRegistration probe(s);
+        probe.setReference(d.tgt_pts);
+        RegistrationSettings one = s;
+        one.gnmm.max_iterations = 1;
+        probe.setSettings(one);
+        row.j_ref = probe.align(d.src_pts, isometryToPose(d.ref)).J_guess;
+      });
+    };
+    for (const auto& m : methods) {
+      for (double e : edges) {
+        std::ostringstream label;
+        label << m << "(E=" << e << ")";
+        if (m == "cubes") {
+          RegistrationSettings s = cube_settings;
+          s.grid.cube_edge = e;
+          addCube(label.str(), s);
+        } else if (m == "cubes-paper") {
+          RegistrationSettings s = RegistrationSettings::paper(e);
+          s.gnmm.seed = cube_settings.gnmm.seed;
+          s.grid.max_cubes = cube_settings.grid.max_cubes;
+          addCube(label.str(), s);
+        }
+      }
+      auto peer = [&](const std::string& name,
+                      PeerResult (*fn)(const Cloud::ConstPtr&, const Cloud::ConstPtr&,
+                                       const Eigen::Isometry3d&),
+                      bool vox) {
+        table.emplace_back(name, [fn, vox](const Data& d, const Eigen::Isometry3d& guess,
+                                           Row& row, Eigen::Isometry3d& est) {
+          const PeerResult r = vox ? fn(d.src_vox, d.tgt_vox, guess) : fn(d.src, d.tgt, guess);
+          est = r.estimate;
+          row.time = r.time_s;
+          row.evaluations = r.iterations;
+        });
+      };
+      if (m == "icp-raw") peer(m, runIcp, false);
+      if (m == "icp-voxel") peer(m, runIcp, true);
+      if (m == "ndt-raw") peer(m, runNdt, false);
+      if (m == "ndt-voxel") peer(m, runNdt, true);
+      if (m == "gicp-voxel") peer(m, runGicp, true);
+    }
+
+    const std::vector<PairEntry> pairs = readPairs(dir);
+    std::ofstream csv(csv_path);
+    if (!csv) throw std::runtime_error(csv_path + ": cannot write");
+    csv << "pair,bounds,method,trial,Es_m,Ea_deg,time_s,evaluations,J,J_ref\n";
+    std::vector<Row> rows;
+    const std::size_t total = pairs.size() * bounds.size() * std::size_t(trials) * table.size();
+    std::size_t done = 0;
+    const auto bench_start = std::chrono::steady_clock::now();
+    for (std::size_t p = 0; p < pairs.size(); ++p) {
+      Data d;
+      d.src = loadCloud(pairs[p].source);
+      d.tgt = loadCloud(pairs[p].target);
+      d.src_vox = voxelCopy(d.src, float(voxel));
+      d.tgt_vox = voxelCopy(d.tgt, float(voxel));
+      d.src_pts = filterPoints(toPointArray(*d.src), filter);
+      d.tgt_pts = filterPoints(toPointArray(*d.tgt), filter);
+      d.ref = pairs[p].T_target_source;
+      std::fprintf(stderr, "pair %s: %zu -> %zu points (voxel copies %zu, %zu)\n",
+                   pairs[p].name.c_str(), d.src->size(), d.tgt->size(), d.src_vox->size(),
+                   d.tgt_vox->size());
+      const Pose6 ref_pose = isometryToPose(d.ref);
+      for (const Bounds& b : bounds) {
+        std::mt19937_64 rng(trial_seed * 1000003ULL + p * 7919ULL + (b.name == "big" ? 0 : 1));
+        std::uniform_real_distribution<double> u(-1.0, 1.0);
+        for (int t = 0; t < trials; ++t) {
+          Pose6 g = ref_pose;
+          for (int k = 0; k < 3; ++k) g[k] += b.t_m * u(rng);
+          for (int k = 3; k < 6; ++k) g[k] += deg2rad(b.a_deg) * u(rng);
+          const Eigen::Isometry3d guess = poseToIsometry(g);
+          for (const auto& [name, run] : table) {
+            Row row{pairs[p].name, b.name, name, t, 0, 0, 0, 0, -1, -1};
+            Eigen::Isometry3d est;
+            run(d, guess, row, est);
+            const PoseError err = poseError(est, d.ref);
+            row.es = err.es_m;
+            row.ea = err.ea_deg;
+            rows.push_back(row);
+            csv << row.pair << ',' << row.bounds << ',' << row.method << ',' << row.trial << ','
+                << row.es << ',' << row.ea << ',' << row.time << ',' << row.evaluations << ','
+                << row.j << ',' << row.j_ref << '\n';
+            ++done;
+            const double el = std::chrono::duration<double>(std::chrono::steady_clock::now() -
+                                                            bench_start).count();
+            std::fprintf(stderr, "\r[%zu/%zu] %.0f s elapsed, ~%.0f s left   ", done, total, el,
+                         el / double(done) * double(total - done));
+          }
+        }
+      }
+      std::fprintf(stderr, "\n");
+    }
+
+    // Summary: median Es, Ea, time, successes; time ratio to the first cube method.
+    std::printf("\n%-44s %-6s %-22s %9s %9s %10s %8s %10s\n", "pair", "bounds", "method",
+                "med Es[m]", "med Ea[°]", "med t[s]", "success", "t/t_cube");
+    bool require_ok = true;
+    for (const auto& pair : pairs) {
+      for (const Bounds& b : bounds) {
+        double cube_time = 0.0;
+        for (const auto& [name, run] : table) {
+          std::vector<double> es, ea, tm;
+          int ok = 0;
+          for (const Row& r : rows) {
+            if (r.pair != pair.name || r.bounds != b.name || r.method != name) continue;
+            es.push_back(r.es);
+            ea.push_back(r.ea);
+            tm.push_back(r.time);
+            ok += (r.es < 0.10 && r.ea < 1.0);
+          }
+          const double mt = median(tm);
+          const bool is_cube = name.rfind("cubes", 0) == 0;
+          if (is_cube && cube_time == 0.0) cube_time = mt;
+          if (is_cube && require >= 0 && ok < require) require_ok = false;
+          std::printf("%-44s %-6s %-22s %9.4f %9.3f %10.4f %5d/%-2d %10.1f\n", pair.name.c_str(),
+                      b.name.c_str(), name.c_str(), median(es), median(ea), mt, ok, int(es.size()),
+                      cube_time > 0 ? mt / cube_time : 0.0);
+        }
+      }
+    }
+    std::printf("success: Es < 0.10 m and Ea < 1 deg; t/t_cube: median time over the first cube "
+                "method's; CSV: %s\n", csv_path.c_str());
+    if (!require_ok) {
+      std::fprintf(stderr, "benchmark: a cube method succeeded in fewer than %d of %d trials\n",
+                   require, trials);
+      return 3;
+    }
+  } catch (const std::exception& e) {
+    std::cerr << "benchmark: " << e.what() << "\n";
+    return 1;
+  }
+  return 0;
+}

@@ -1,0 +1,53 @@
+#include "dataset.h"
+
+#include <cmath>
+#include <fstream>
+#include <sstream>
+#include <stdexcept>
+
+#include "cube_scan_matcher/core/pose.h"
+
+namespace cube_scan_matcher::tools {
+
+std::vector<PairEntry> readPairs(const std::string& dir) {
+  const std::string file = dir + "/pairs.txt";
+  std::ifstream in(file);
+  if (!in) throw std::runtime_error(file + ": cannot open (is " + dir + " a dataset folder?)");
+  std::vector<PairEntry> pairs;
+  std::string line;
+  for (int no = 1; std::getline(in, line); ++no) {
+    if (line.find_first_not_of(" \t\r") == std::string::npos || line[0] == '#') continue;
+    std::istringstream ls(line);
+    PairEntry e;
+    double t[3], q[4];
+    if (!(ls >> e.source >> e.target >> t[0] >> t[1] >> t[2] >> q[0] >> q[1] >> q[2] >> q[3])) {
+      throw std::runtime_error(file + ":" + std::to_string(no) +
+                               ": expected 'source target tx ty tz qx qy qz qw'");
+    }
+    const Eigen::Quaterniond quat(q[3], q[0], q[1], q[2]);
+    if (std::abs(quat.norm() - 1.0) > 1e-3) {
+      throw std::runtime_error(file + ":" + std::to_string(no) + ": quaternion is not unit");
+    }
+    e.name = e.source + "->" + e.target;
+    e.T_target_source.linear() = quat.normalized().toRotationMatrix();
+    e.T_target_source.translation() = Eigen::Vector3d(t[0], t[1], t[2]);
+    e.source = dir + "/" + e.source;
+    e.target = dir + "/" + e.target;
+    pairs.push_back(e);
+  }
+  if (pairs.empty()) throw std::runtime_error(file + ": no pairs");
+  return pairs;
+}
+
+PoseError poseError(const Eigen::Isometry3d& estimate, const Eigen::Isometry3d& reference) {
+  const Pose6 a = isometryToPose(estimate);
+  const Pose6 b = isometryToPose(reference);
+  double sum = 0.0;
+  for (int k = 3; k < 6; ++k) {
+    const double d = wrapAngle(a[k] - b[k]);
+    sum += d * d;
+  }
+  return {(a.head<3>() - b.head<3>()).norm(), rad2deg(std::sqrt(sum))};
+}
+
+}  // namespace cube_scan_matcher::tools

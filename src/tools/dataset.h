@@ -1,0 +1,29 @@
+// Dataset folders in the format of shared/data/README.md: pairs.txt lines
+//   source.pcd target.pcd tx ty tz qx qy qz qw      (T_target_source, metres, Hamilton)
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include <Eigen/Geometry>
+
+namespace cube_scan_matcher::tools {
+
+struct PairEntry {
+  std::string source;  ///< newer scan (path joined with the folder)
+  std::string target;  ///< reference scan
+  Eigen::Isometry3d T_target_source = Eigen::Isometry3d::Identity();
+  std::string name;    ///< "source->target" file names
+};
+
+/// Reads DIR/pairs.txt. Throws std::runtime_error naming the file and line on bad input.
+std::vector<PairEntry> readPairs(const std::string& dir);
+
+/// Errors of eqs. (7)-(8): Es [m] and Ea [deg] between an estimate and a reference.
+struct PoseError {
+  double es_m;
+  double ea_deg;
+};
+PoseError poseError(const Eigen::Isometry3d& estimate, const Eigen::Isometry3d& reference);
+
+}  // namespace cube_scan_matcher::tools

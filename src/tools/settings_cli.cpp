@@ -1,0 +1,91 @@
+#include "settings_cli.h"
+
+#include <cstdlib>
+#include <stdexcept>
+
+#include "cube_scan_matcher/core/defaults.h"
+
+namespace cube_scan_matcher::tools {
+
+RegistrationSettings defaultSettings() { return cube_scan_matcher::defaultSettings(); }
+
+std::string algorithmOptionsHelp() {
+  const RegistrationSettings d = defaultSettings();
+  const RangeFilterSettings f;
+  auto num = [](double v) {
+    std::string s = std::to_string(v);
+    s.erase(s.find_last_not_of('0') + 1);
+    if (s.back() == '.') s.pop_back();
+    return s;
+  };
+  return std::string() +
+         "  --edge E              cube edge E [m] (default " + num(d.grid.cube_edge) + "; paper 0.3-0.5)\n"
+         "  --vertices N          GNMM population size (default " + std::to_string(d.gnmm.vertices) + ", >= 7)\n"
+         "  --iterations N        GNMM iterations (default " + std::to_string(d.gnmm.max_iterations) + ")\n"
+         "  --stall N             stop after N iterations without improvement, 0 = never\n"
+         "                        (default " + std::to_string(d.gnmm.stall_iterations) + ")\n"
+         "  --restart-shrink F    restart box factor around the best vertex, 1 = paper's restarts\n"
+         "                        around the initial estimate (default " + num(d.gnmm.restart_shrink) + ")\n"
+         "  --bounds T A          restart half-widths: T [m] for x,y,z and A [deg] for roll,pitch,yaw\n"
+         "                        (default " + num(d.gnmm.bounds[0]) + " m, " + num(rad2deg(d.gnmm.bounds[3])) + " deg)\n"
+         "  --collapse F          keep one scan point per voxel of F*E before the search,\n"
+         "                        0 = all points as in the paper (default " + num(d.collapse_fraction) + ")\n"
+         "  --seed N              RNG seed (default " + std::to_string(d.gnmm.seed) + ")\n"
+         "  --max-cubes N         memory cap on the grid [cubes = bits] (default 2^31)\n"
+         "  --min-range R         drop points closer than R [m] to the origin (default " + num(f.min_range) + ")\n"
+         "  --max-range R         drop points farther than R [m] (default none)\n"
+         "  --paper               the paper's fixed mode: 15 vertices, 500 iterations, all points,\n"
+         "                        restarts around the initial estimate (resets the options before it)\n";
+}
+
+double parseNumber(const std::string& option, const std::string& value) {
+  char* end = nullptr;
+  const double v = std::strtod(value.c_str(), &end);
+  if (value.empty() || *end != '\0') {
+    throw std::invalid_argument(option + ": '" + value + "' is not a number");
+  }
+  return v;
+}
+
+bool parseAlgorithmOption(const std::vector<std::string>& args, std::size_t& i,
+                          RegistrationSettings& s, RangeFilterSettings& f) {
+  const std::string& a = args[i];
+  auto value = [&](int k) -> double {
+    if (i + k >= args.size()) throw std::invalid_argument(a + ": missing value");
+    return parseNumber(a, args[i + k]);
+  };
+  std::size_t used = 1;
+  if (a == "--edge") {
+    s.grid.cube_edge = value(1), used = 2;
+  } else if (a == "--vertices") {
+    s.gnmm.vertices = int(value(1)), used = 2;
+  } else if (a == "--iterations") {
+    s.gnmm.max_iterations = int(value(1)), used = 2;
+  } else if (a == "--stall") {
+    s.gnmm.stall_iterations = int(value(1)), used = 2;
+  } else if (a == "--restart-shrink") {
+    s.gnmm.restart_shrink = value(1), used = 2;
+  } else if (a == "--bounds") {
+    const double t = value(1), ang = deg2rad(value(2));
+    s.gnmm.bounds << t, t, t, ang, ang, ang;
+    used = 3;
+  } else if (a == "--collapse") {
+    s.collapse_fraction = value(1), used = 2;
+  } else if (a == "--seed") {
+    s.gnmm.seed = std::uint64_t(value(1)), used = 2;
+  } else if (a == "--max-cubes") {
+    s.grid.max_cubes = std::uint64_t(value(1)), used = 2;
+  } else if (a == "--min-range") {
+    f.min_range = value(1), used = 2;
+  } else if (a == "--max-range") {
+    f.max_range = value(1), used = 2;
+  } else if (a == "--paper") {
+    s = RegistrationSettings::paper(s.grid.cube_edge);
+  } else {
+    return false;
+  }
+  i += used;
+  return true;
+}
+
+}  // namespace cube_scan_matcher::tools

@@ -1,0 +1,26 @@
+// Command-line options shared by the tools that run the cube method (one parser, one help text).
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "cube_scan_matcher/core/filters.h"
+#include "cube_scan_matcher/core/registration.h"
+
+namespace cube_scan_matcher::tools {
+
+/// Help lines for the algorithm options (unit and default of each).
+std::string algorithmOptionsHelp();
+
+/// If args[i] is an algorithm option, consumes it (and its values), updates `settings` or
+/// `filter`, advances i past it and returns true. Throws std::invalid_argument on a bad value.
+bool parseAlgorithmOption(const std::vector<std::string>& args, std::size_t& i,
+                          RegistrationSettings& settings, RangeFilterSettings& filter);
+
+/// Reads a number or throws std::invalid_argument naming the option.
+double parseNumber(const std::string& option, const std::string& value);
+
+/// The package's default settings (the fast mode documented in README and BENCHMARK.md).
+RegistrationSettings defaultSettings();
+
+}  // namespace cube_scan_matcher::tools
