@@ -16,6 +16,10 @@ void validate(const CubeGridSettings& s) {
     throw std::invalid_argument("max_cubes must be in [1, 2^31], got " +
                                 std::to_string(s.max_cubes));
   }
+  if (!(s.origin_shift >= 0.0 && s.origin_shift < 1.0)) {
+    throw std::invalid_argument("origin_shift must be in [0, 1), got " +
+                                std::to_string(s.origin_shift));
+  }
 }
 
 namespace {
@@ -37,11 +41,13 @@ GridAffine CubeGrid::affine(const Eigen::Matrix3f& rotation,
   return makeAffine(rotation, translation, min_, edge_);
 }
 
-// The hot loop. Cloned for AVX-512/AVX2 and dispatched at load time; `omp simd` (with
+// The hot loop. Cloned for AVX-512/AVX2 and dispatched at load time on CPU *features* (an
+// "arch=" clone would dispatch on the Intel model name and miss AMD CPUs); `omp simd` (with
 // -fopenmp-simd, no OpenMP runtime) makes GCC vectorise it at -O2.
-__attribute__((target_clones("default", "arch=haswell", "arch=skylake-avx512")))
+__attribute__((target_clones("default", "avx2", "avx512f")))
 void computeCubeIndices(const GridAffine& g, const Eigen::Vector3f& dims, const float* x,
-                        const float* y, const float* z, std::size_t n, std::int32_t* idx) {
+                        const float* y, const float* z, std::size_t n, std::int32_t outside,
+                        std::int32_t* idx) {
   const float nx = dims.x(), ny = dims.y(), nz = dims.z();
   // Unsigned arithmetic: the index of a clamped outside point may wrap (it is discarded), an
   // inside index is < v <= 2^31 and fits an int32.
@@ -61,7 +67,7 @@ void computeCubeIndices(const GridAffine& g, const Eigen::Vector3f& dims, const 
     const std::uint32_t ix = std::uint32_t(std::int32_t(std::min(std::max(ax, 0.f), nx)));
     const std::uint32_t iy = std::uint32_t(std::int32_t(std::min(std::max(ay, 0.f), ny)));
     const std::uint32_t iz = std::uint32_t(std::int32_t(std::min(std::max(az, 0.f), nz)));
-    idx[i] = inside ? std::int32_t(ix + iy * sx + iz * sxy) : -1;
+    idx[i] = inside ? std::int32_t(ix + iy * sx + iz * sxy) : outside;
   }
 }
 
@@ -84,6 +90,7 @@ CubeGrid CubeGrid::build(const PointArray& ref, const CubeGridSettings& settings
     lo = lo.cwiseMin(p);
     hi = hi.cwiseMax(p);
   }
+  lo.array() -= settings.origin_shift * g.edge_;
   g.min_ = lo;
   g.max_ = hi;
   // Nx = round((xmax - xmin)/E) + 1 (eq. 4 plus the inclusive upper bound). Checked in double
@@ -112,7 +119,7 @@ CubeGrid CubeGrid::build(const PointArray& ref, const CubeGridSettings& settings
   g.dims_f_ = g.dims_.cast<float>();
   g.bits_.assign((g.cubeCount() + 63) / 64, 0);
   std::vector<std::int32_t> idx(ref.size());
-  computeCubeIndices(id, g.dims_f_, ref.x.data(), ref.y.data(), ref.z.data(), ref.size(),
+  computeCubeIndices(id, g.dims_f_, ref.x.data(), ref.y.data(), ref.z.data(), ref.size(), -1,
                      idx.data());
   for (std::int32_t i : idx) {
     if (i < 0) continue;  // cannot happen for points inside their own box; kept for safety
@@ -129,7 +136,7 @@ CubeGrid CubeGrid::build(const PointArray& ref, const CubeGridSettings& settings
 std::int64_t CubeGrid::index(const Eigen::Vector3f& p) const {
   const GridAffine id = affine(Eigen::Matrix3f::Identity(), Eigen::Vector3f::Zero());
   std::int32_t out;
-  computeCubeIndices(id, dims_f_, &p.x(), &p.y(), &p.z(), 1, &out);
+  computeCubeIndices(id, dims_f_, &p.x(), &p.y(), &p.z(), 1, -1, &out);
   return out;
 }
 

@@ -20,6 +20,17 @@ RegistrationSettings RegistrationSettings::paper(double cube_edge) {
 void validate(const RegistrationSettings& s) {
   validate(s.grid);
   validate(s.gnmm);
+  if (s.refine.enabled) {
+    if (!(s.refine.edge_fraction > 0.0 && s.refine.edge_fraction < 1.0)) {
+      throw std::invalid_argument("refine edge_fraction must be in (0, 1), got " +
+                                  std::to_string(s.refine.edge_fraction));
+    }
+    validate(s.refine.gnmm);
+    if (s.refine.grids < 1 || s.refine.grids > 8) {
+      throw std::invalid_argument("refine grids must be in [1, 8], got " +
+                                  std::to_string(s.refine.grids));
+    }
+  }
   if (!(s.collapse_fraction >= 0.0 && s.collapse_fraction <= 1.0)) {
     throw std::invalid_argument("collapse_fraction must be in [0, 1], got " +
                                 std::to_string(s.collapse_fraction));
@@ -46,7 +57,19 @@ void CubeRegistration::setSettings(const RegistrationSettings& settings) {
 }
 
 void CubeRegistration::setReference(const PointArray& reference) {
-  grid_ = CubeGrid::build(reference, settings_.grid);  // throws before touching grid_
+  // Both grids are built before either is replaced, so an error keeps the previous reference.
+  CubeGrid coarse = CubeGrid::build(reference, settings_.grid);
+  std::vector<CubeGrid> fine;
+  if (settings_.refine.enabled) {
+    CubeGridSettings gs = settings_.grid;
+    gs.cube_edge *= settings_.refine.edge_fraction;
+    for (int k = 0; k < settings_.refine.grids; ++k) {
+      gs.origin_shift = double(k) / settings_.refine.grids;
+      fine.push_back(CubeGrid::build(reference, gs));
+    }
+  }
+  grid_ = std::move(coarse);
+  fine_grids_ = std::move(fine);
   has_reference_ = true;
 }
 
@@ -75,18 +98,39 @@ RegistrationResult CubeRegistration::align(const PointArray& scan, const Pose6& 
   res.points_used = points->size();
 
   CoincidenceObjective objective(grid_, *points);
-  const Gnmm gnmm(settings_.gnmm);
-  const GnmmResult g =
-      gnmm.maximize([&objective](const Vector6d& p) { return double(objective(p)); }, guess);
+  const GnmmResult g = Gnmm(settings_.gnmm).maximize(
+      [&objective](const Vector6d& p) { return double(objective(p)); }, guess);
   res.pose = g.best;
-  for (int k = 3; k < 6; ++k) res.pose[k] = wrapAngle(res.pose[k]);
-  res.transform = poseToIsometry(res.pose);
-  res.J = int(g.best_value);
+  res.J = res.J_coarse = int(g.best_value);
   res.J_guess = int(g.initial_value);
   res.evaluations = g.evaluations;
   res.iterations = g.iterations;
   res.restarts = g.restarts;
   res.stop = g.stop;
+
+  // Refine stage (not in the paper): fine cubes in a small box around the coarse result. The
+  // fine grid's edge is inside the cell size of the collapse voxel only if collapse_fraction
+  // is small enough; the same collapsed points are used for simplicity and speed.
+  if (settings_.refine.enabled && res.J > 0 && !fine_grids_.empty()) {
+    std::vector<CoincidenceObjective> fine;
+    fine.reserve(fine_grids_.size());
+    for (const CubeGrid& grid : fine_grids_) fine.emplace_back(grid, *points);
+    const GnmmResult f = Gnmm(settings_.refine.gnmm).maximize(
+        [&fine](const Vector6d& p) {
+          int sum = 0;
+          for (CoincidenceObjective& j : fine) sum += j(p);
+          return double(sum);
+        },
+        res.pose);
+    res.pose = f.best;
+    res.evaluations += f.evaluations;
+    res.iterations += f.iterations;
+    res.restarts += f.restarts;
+    res.stop = f.stop;
+    res.J = objective(res.pose);
+  }
+  for (int k = 3; k < 6; ++k) res.pose[k] = wrapAngle(res.pose[k]);
+  res.transform = poseToIsometry(res.pose);
   if (res.J == 0) {
     return finish(RegistrationStatus::NoOverlap,
                   "no scan point fell in a reference cube at any tried pose (no overlap)");

@@ -30,6 +30,12 @@ std::string algorithmOptionsHelp() {
          "                        (default " + num(d.gnmm.bounds[0]) + " m, " + num(rad2deg(d.gnmm.bounds[3])) + " deg)\n"
          "  --collapse F          keep one scan point per voxel of F*E before the search,\n"
          "                        0 = all points as in the paper (default " + num(d.collapse_fraction) + ")\n"
+         "  --refine F            second GNMM stage on cubes of F*E around the first result,\n"
+         "                        0 = off as in the paper (default " + num(d.refine.enabled ? d.refine.edge_fraction : 0.0) + ")\n"
+         "  --refine-grids K      refine on the sum of J over K fine grids shifted by 1/K cube\n"
+         "                        (anti-aliasing; default " + std::to_string(d.refine.grids) + ")\n"
+         "  --refine-iterations N iterations of the refine stage (default " + std::to_string(d.refine.gnmm.max_iterations) + ")\n"
+         "  --refine-bounds T A   refine box half-widths T [m], A [deg] (default " + num(d.refine.gnmm.bounds[0]) + " m, " + num(rad2deg(d.refine.gnmm.bounds[3])) + " deg)\n"
          "  --seed N              RNG seed (default " + std::to_string(d.gnmm.seed) + ")\n"
          "  --max-cubes N         memory cap on the grid [cubes = bits] (default 2^31)\n"
          "  --min-range R         drop points closer than R [m] to the origin (default " + num(f.min_range) + ")\n"
@@ -68,6 +74,18 @@ bool parseAlgorithmOption(const std::vector<std::string>& args, std::size_t& i,
   } else if (a == "--bounds") {
     const double t = value(1), ang = deg2rad(value(2));
     s.gnmm.bounds << t, t, t, ang, ang, ang;
+    used = 3;
+  } else if (a == "--refine") {
+    s.refine.enabled = value(1) > 0.0;
+    if (s.refine.enabled) s.refine.edge_fraction = value(1);
+    used = 2;
+  } else if (a == "--refine-grids") {
+    s.refine.grids = int(value(1)), used = 2;
+  } else if (a == "--refine-iterations") {
+    s.refine.gnmm.max_iterations = int(value(1)), used = 2;
+  } else if (a == "--refine-bounds") {
+    const double t = value(1), ang = deg2rad(value(2));
+    s.refine.gnmm.bounds << t, t, t, ang, ang, ang;
     used = 3;
   } else if (a == "--collapse") {
     s.collapse_fraction = value(1), used = 2;

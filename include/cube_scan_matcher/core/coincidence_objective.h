@@ -2,6 +2,7 @@
 // least one scan point falls into, for a candidate pose. It knows nothing about the optimizer.
 #pragma once
 
+#include <algorithm>
 #include <cstdint>
 #include <vector>
 
@@ -26,7 +27,10 @@ class CoincidenceObjective {
   /// Number of evaluations so far.
   long evaluations() const { return evaluations_; }
   /// True if the working copy of V equals the grid's V (it must, between evaluations).
-  bool workingCopyRestored() const { return work_ == grid_.bits(); }
+  bool workingCopyRestored() const {
+    return std::equal(grid_.bits().begin(), grid_.bits().end(), work_.begin()) &&
+           work_.back() == 0;
+  }
 
  private:
   static constexpr std::size_t kBlock = 1024;  // points per index block (stays in L1)
@@ -35,6 +39,7 @@ class CoincidenceObjective {
   std::vector<std::uint64_t> work_;  // V, cleared on hit and restored after each evaluation
   std::vector<std::int32_t> hits_;   // indices cleared in this evaluation (J of them)
   std::vector<std::int32_t> idx_;    // block of cube indices
+  std::int32_t outside_ = 0;         // index of the spare zero cube past V
   long evaluations_ = 0;
 };
 

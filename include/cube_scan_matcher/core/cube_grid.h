@@ -23,6 +23,10 @@ struct CubeGridSettings {
   /// Memory guard: largest allowed v = Nx*Ny*Nz [cubes = bits], in [1, 2^31]. The default
   /// 2^31 bits is 256 MiB; a larger grid (absurd extent or tiny E) is refused with an error.
   std::uint64_t max_cubes = std::uint64_t{1} << 31;
+  /// Beyond the paper: the grid origin is moved to min - origin_shift * E (same on all axes),
+  /// in [0, 1). Grids with different shifts cut space at different places; summing their J
+  /// smooths the aliasing of a single grid. 0 = the paper's grid.
+  double origin_shift = 0.0;
 };
 
 /// Throws std::invalid_argument naming the bad setting.
@@ -87,9 +91,12 @@ class CubeGrid {
   std::vector<std::int32_t> list_;   ///< L, unsorted indices of set cubes.
 };
 
-/// Eq. (5)-(6) for a block of points: idx[i] = linear index of A p_i + b, or -1 outside the
-/// grid. The per-point loop of the method: contiguous floats in, int32 out, vectorised.
+/// Eq. (5)-(6) for a block of points: idx[i] = linear index of A p_i + b, or `outside` for a
+/// point outside the grid. The per-point loop of the method: contiguous floats in, int32 out,
+/// vectorised; the objective passes the index of a spare always-zero cube as `outside`, so its
+/// counting loop needs no branch.
 void computeCubeIndices(const GridAffine& affine, const Eigen::Vector3f& dims, const float* x,
-                        const float* y, const float* z, std::size_t n, std::int32_t* idx);
+                        const float* y, const float* z, std::size_t n, std::int32_t outside,
+                        std::int32_t* idx);
 
 }  // namespace cube_scan_matcher

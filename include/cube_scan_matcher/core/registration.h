@@ -4,6 +4,7 @@
 
 #include <cstddef>
 #include <string>
+#include <vector>
 
 #include <Eigen/Geometry>
 
@@ -14,9 +15,28 @@
 
 namespace cube_scan_matcher {
 
+/// Beyond the paper: a second GNMM search on a finer grid, in a small box around the result of
+/// the first. The coarse cubes give the wide basin of convergence, the fine cubes the accuracy.
+struct RefineSettings {
+  bool enabled = false;
+  double edge_fraction = 0.5;  ///< fine edge = edge_fraction * E, in (0, 1).
+  /// Fine grids with origins shifted by k/grids of a fine cube, k = 0..grids-1; the refine
+  /// objective is the sum of their J (anti-aliasing). In [1, 8].
+  int grids = 1;
+  GnmmSettings gnmm = [] {
+    GnmmSettings g;
+    g.max_iterations = 150;
+    g.stall_iterations = 40;
+    g.bounds << 0.1, 0.1, 0.1, 0.017453292519943295, 0.017453292519943295,
+        0.017453292519943295;  // +-0.1 m, +-1 deg around the coarse result
+    return g;
+  }();
+};
+
 struct RegistrationSettings {
   CubeGridSettings grid;  ///< E and the memory cap.
   GnmmSettings gnmm;      ///< population, iterations, restart bounds, seed.
+  RefineSettings refine;  ///< optional fine stage (off in the paper's mode).
   /// Beyond the paper: before the search, keep one scan point per voxel of edge
   /// collapse_fraction * E. 0 = off, every point is evaluated (paper). In [0, 1].
   double collapse_fraction = 0.0;
@@ -41,14 +61,15 @@ struct RegistrationResult {
   RegistrationStatus status = RegistrationStatus::NoReference;
   Pose6 pose = Pose6::Zero();  ///< [m, m, m, rad, rad, rad]: scan -> reference (eq. 2).
   Eigen::Isometry3d transform = Eigen::Isometry3d::Identity();  ///< same pose as a matrix.
-  int J = 0;                      ///< coincident cubes at the result.
+  int J = 0;                      ///< coincident cubes of edge E at the result.
   int J_guess = 0;                ///< coincident cubes at the initial estimate.
   std::size_t reference_cubes = 0;  ///< l: set cubes of the reference.
   std::size_t points_in = 0;      ///< scan points given.
   std::size_t points_used = 0;    ///< scan points evaluated (after collapsing).
-  int evaluations = 0;
-  int iterations = 0;
-  int restarts = 0;
+  int evaluations = 0;             ///< objective evaluations, both stages.
+  int iterations = 0;              ///< GNMM iterations, both stages.
+  int restarts = 0;                ///< GNMM restarts, both stages.
+  int J_coarse = 0;                ///< J at E after the first stage (= J when refine is off).
   GnmmStop stop = GnmmStop::MaxIterations;  ///< why the search stopped.
   double time_s = 0.0;            ///< wall time of align() [s].
   std::string message;            ///< human-readable summary or reason of failure.
@@ -67,6 +88,8 @@ class CubeRegistration {
   void setReference(const PointArray& reference);
   bool hasReference() const { return has_reference_; }
   const CubeGrid& grid() const { return grid_; }
+  /// The fine grids of the refine stage (none when refine is off).
+  const std::vector<CubeGrid>& fineGrids() const { return fine_grids_; }
 
   /// Registers `scan` to the reference around `guess` (scan -> reference).
   RegistrationResult align(const PointArray& scan, const Pose6& guess) const;
@@ -79,6 +102,7 @@ class CubeRegistration {
  private:
   RegistrationSettings settings_;
   CubeGrid grid_;
+  std::vector<CubeGrid> fine_grids_;
   bool has_reference_ = false;
 };
 

@@ -1,0 +1,42 @@
+// A 2D laser range-finder on a tilting mount, as the paper's (section 3.1, eq. 1): phi sweeps
+// the 2D scan plane about Z, psi tilts it about X. In the sensor frame, a range r at (phi, psi)
+// is the point [C(phi) r, C(psi) S(phi) r, S(psi) S(phi) r] (eq. 1), so phi = 90 deg, psi = 0
+// looks along +Y. Defaults: phi over 180 deg in 0.5 deg steps, psi over 60 deg in 1/3 deg
+// steps (361 x 181 = 65,341 beams), 81 m maximum range, +-4 cm range noise.
+#pragma once
+
+#include <cstdint>
+#include <random>
+
+#include <Eigen/Geometry>
+
+#include "cube_scan_matcher/core/point_array.h"
+#include "cube_scan_matcher/sim/scene.h"
+
+namespace cube_scan_matcher::sim {
+
+struct ScannerModel {
+  double phi_min_deg = 0.0, phi_max_deg = 180.0, phi_step_deg = 0.5;
+  double psi_min_deg = -30.0, psi_max_deg = 30.0, psi_step_deg = 1.0 / 3.0;
+  double max_range = 81.0;    ///< [m] beams beyond it (or with no return) give no point
+  double range_noise = 0.04;  ///< [m] uniform +-noise added to every range
+  int phiCount() const;       ///< beams per 2D scan (361 by default)
+  int psiCount() const;       ///< 2D scans per sweep (181 by default)
+};
+
+/// Sensor-frame axes of eq. (1) relative to a REP-103 body (x forward, y left, z up): the
+/// sensor's +Y (phi = 90 deg) looks along the body's +x, its +X along the body's -y.
+Eigen::Matrix3d sensorToBodyRotation();
+
+struct SweepOptions {
+  /// true: one point per beam, NaN for no return (an organised cloud, as some drivers give);
+  /// false: beams without a return are dropped.
+  bool keep_invalid = false;
+};
+
+/// Casts every beam of one sweep from `sensor_pose` (sensor frame of eq. 1 -> world) and
+/// returns the points in the sensor frame.
+PointArray scan(const Scene& scene, const ScannerModel& model, const Eigen::Isometry3d& sensor_pose,
+                std::mt19937_64& rng, const SweepOptions& options = {});
+
+}  // namespace cube_scan_matcher::sim

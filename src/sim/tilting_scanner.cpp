@@ -1,0 +1,74 @@
+#include "cube_scan_matcher/sim/tilting_scanner.h"
+
+#include <cmath>
+#include <limits>
+
+#include "cube_scan_matcher/core/pose.h"
+
+namespace cube_scan_matcher::sim {
+
+int ScannerModel::phiCount() const {
+  return int(std::floor((phi_max_deg - phi_min_deg) / phi_step_deg + 1e-6)) + 1;
+}
+int ScannerModel::psiCount() const {
+  return int(std::floor((psi_max_deg - psi_min_deg) / psi_step_deg + 1e-6)) + 1;
+}
+
+Eigen::Matrix3d sensorToBodyRotation() {
+  // Columns: sensor X, Y, Z in body coordinates. Sensor Y (phi = 90 deg) = body +x,
+  // sensor X = body -y, sensor Z = body +z (right-handed: X x Y = Z).
+  Eigen::Matrix3d r;
+  r << 0, 1, 0,  //
+      -1, 0, 0,  //
+      0, 0, 1;
+  return r;
+}
+
+PointArray scan(const Scene& full_scene, const ScannerModel& m, const Eigen::Isometry3d& pose,
+                std::mt19937_64& rng, const SweepOptions& options) {
+  // Cull primitives that no beam can reach.
+  const Eigen::Vector3d o = pose.translation();
+  Scene scene;
+  scene.planes = full_scene.planes;
+  const double reach = m.max_range + 1.0;
+  for (const Box& b : full_scene.boxes) {
+    const Eigen::Vector3d c = o.cwiseMax(b.lo).cwiseMin(b.hi);
+    if ((c - o).norm() <= reach) scene.boxes.push_back(b);
+  }
+  for (const Cylinder& c : full_scene.cylinders) {
+    if (std::hypot(c.cx - o.x(), c.cy - o.y()) - c.r <= reach) scene.cylinders.push_back(c);
+  }
+  for (const Sphere& s : full_scene.spheres) {
+    if ((s.c - o).norm() - s.r <= reach) scene.spheres.push_back(s);
+  }
+
+  std::uniform_real_distribution<double> noise(-m.range_noise, m.range_noise);
+  const float nan = std::numeric_limits<float>::quiet_NaN();
+  PointArray out;
+  out.reserve(std::size_t(m.phiCount()) * m.psiCount());
+  const Eigen::Matrix3d rot = pose.linear();
+  for (int j = 0; j < m.psiCount(); ++j) {
+    const double psi = deg2rad(m.psi_min_deg + j * m.psi_step_deg);
+    for (int i = 0; i < m.phiCount(); ++i) {
+      const double phi = deg2rad(m.phi_min_deg + i * m.phi_step_deg);
+      // Eq. (1) with r = 1: the beam direction in the sensor frame.
+      const Eigen::Vector3d dir(std::cos(phi), std::cos(psi) * std::sin(phi),
+                                std::sin(psi) * std::sin(phi));
+      const double t = scene.raycast(o, rot * dir, m.max_range);
+      if (t <= 0.0) {
+        if (options.keep_invalid) out.push_back(nan, nan, nan);
+        continue;
+      }
+      const double r = t + noise(rng);
+      if (r > m.max_range || r <= 0.0) {
+        if (options.keep_invalid) out.push_back(nan, nan, nan);
+        continue;
+      }
+      const Eigen::Vector3f p = (dir * r).cast<float>();
+      out.push_back(p.x(), p.y(), p.z());
+    }
+  }
+  return out;
+}
+
+}  // namespace cube_scan_matcher::sim

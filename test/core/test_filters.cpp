@@ -1,0 +1,65 @@
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <limits>
+
+#include "cube_scan_matcher/core/filters.h"
+#include "cube_scan_matcher/core/voxel_collapse.h"
+
+using namespace cube_scan_matcher;
+
+TEST(Filters, DropsNonFiniteAndOutOfRange) {
+  PointArray in;
+  const float nan = std::numeric_limits<float>::quiet_NaN();
+  const float inf = std::numeric_limits<float>::infinity();
+  in.push_back(1, 0, 0);
+  in.push_back(nan, 0, 0);
+  in.push_back(0, inf, 0);
+  in.push_back(0.1f, 0, 0);  // too close
+  in.push_back(90, 0, 0);    // too far
+  in.push_back(0, 0, 50);
+  RangeFilterSettings s;
+  s.min_range = 0.5;
+  s.max_range = 81;
+  FilterStats st;
+  const PointArray out = filterPoints(in, s, &st);
+  ASSERT_EQ(out.size(), 2u);
+  EXPECT_EQ(st.non_finite, 2u);
+  EXPECT_EQ(st.out_of_range, 2u);
+  EXPECT_EQ(st.kept, 2u);
+  EXPECT_FLOAT_EQ(out.z[1], 50.f);
+}
+
+TEST(Filters, RangeIsMeasuredFromTheOrigin) {
+  PointArray in;
+  in.push_back(10, 0, 0);
+  RangeFilterSettings s;
+  s.max_range = 5;
+  s.origin = Eigen::Vector3d(8, 0, 0);
+  EXPECT_EQ(filterPoints(in, s).size(), 1u);
+}
+
+TEST(Filters, InvalidSettingsAreRefusedByName) {
+  RangeFilterSettings s;
+  s.min_range = -1;
+  EXPECT_THROW(validate(s), std::invalid_argument);
+  s.min_range = 5;
+  s.max_range = 2;
+  try {
+    validate(s);
+    FAIL();
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("max_range"), std::string::npos);
+  }
+}
+
+TEST(VoxelCollapse, KeepsOnePointPerVoxel) {
+  PointArray in;
+  for (int i = 0; i < 10; ++i) in.push_back(0.01f * i, 0.01f, 0.01f);  // one 0.25 m voxel
+  in.push_back(1.1f, 0.1f, 0.1f);
+  in.push_back(-0.1f, 0.1f, 0.1f);  // negative side is another voxel
+  const PointArray out = collapseToVoxels(in, 0.25);
+  EXPECT_EQ(out.size(), 3u);
+  EXPECT_FLOAT_EQ(out.x[0], 0.f);  // the first point of a voxel is kept
+  EXPECT_THROW(collapseToVoxels(in, 0.0), std::invalid_argument);
+}

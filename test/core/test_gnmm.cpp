@@ -1,0 +1,89 @@
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "cube_scan_matcher/core/gnmm.h"
+
+using namespace cube_scan_matcher;
+
+namespace {
+const Vector6d kOptimum = (Vector6d() << 0.7, -0.4, 0.2, 0.1, -0.05, 0.12).finished();
+Vector6d distantStart() { return kOptimum + (Vector6d() << 0.8, -0.7, 0.6, -0.12, 0.1, -0.13).finished(); }
+
+GnmmSettings bounds(double t, double a) {
+  GnmmSettings s;
+  s.bounds << t, t, t, a, a, a;
+  return s;
+}
+}  // namespace
+
+TEST(Gnmm, MaximisesASmoothFunctionFromADistantStart) {
+  const auto f = [](const Vector6d& x) { return -(x - kOptimum).squaredNorm(); };
+  const GnmmResult r = Gnmm(bounds(1.0, 0.15)).maximize(f, distantStart());
+  EXPECT_LT((r.best - kOptimum).norm(), 1e-3);
+  EXPECT_GT(r.best_value, r.initial_value);
+  EXPECT_EQ(r.iterations, 500);
+  EXPECT_EQ(r.stop, GnmmStop::MaxIterations);
+  EXPECT_GE(r.evaluations, 15 + 500);
+}
+
+TEST(Gnmm, MaximisesAnIntegerPlateauFunction) {
+  // Integer-valued with flat terraces, like J: 100 - sum of floor(|x - x*| / step).
+  const auto f = [](const Vector6d& x) {
+    double v = 100;
+    for (int k = 0; k < 6; ++k) v -= std::floor(std::abs(x[k] - kOptimum[k]) / (k < 3 ? 0.05 : 0.01));
+    return v;
+  };
+  const GnmmResult r = Gnmm(bounds(1.0, 0.15)).maximize(f, distantStart());
+  EXPECT_EQ(r.best_value, 100.0);
+  EXPECT_LT((r.best.head<3>() - kOptimum.head<3>()).cwiseAbs().maxCoeff(), 0.05);
+  EXPECT_LT((r.best.tail<3>() - kOptimum.tail<3>()).cwiseAbs().maxCoeff(), 0.01);
+}
+
+TEST(Gnmm, EscapesALocalMaximumThroughRestarts) {
+  // A narrow global peak next to a broad local one at the start, both terraced into integer
+  // steps like J. (On a *smooth* local peak every contraction improves the worst vertex, so
+  // GNMM never restarts: its restarts are triggered by plateaus, which J has everywhere.)
+  const auto f = [](const Vector6d& x) {
+    const double local = 1.0 * std::exp(-x.squaredNorm() / 0.5);
+    const double global = 2.0 * std::exp(-(x - kOptimum).squaredNorm() / 0.2);
+    return std::floor(20.0 * (local + global));
+  };
+  const GnmmResult r = Gnmm(bounds(1.0, 0.2)).maximize(f, Vector6d::Zero());
+  EXPECT_GE(r.best_value, 38.0);
+  EXPECT_GT(r.restarts, 0);
+}
+
+TEST(Gnmm, IsReproducibleWithAFixedSeed) {
+  const auto f = [](const Vector6d& x) { return -std::floor((x - kOptimum).squaredNorm() * 100); };
+  GnmmSettings s = bounds(1.0, 0.15);
+  s.seed = 7;
+  const GnmmResult a = Gnmm(s).maximize(f, distantStart());
+  const GnmmResult b = Gnmm(s).maximize(f, distantStart());
+  EXPECT_EQ(a.best, b.best);
+  EXPECT_EQ(a.evaluations, b.evaluations);
+  s.seed = 8;
+  const GnmmResult c = Gnmm(s).maximize(f, distantStart());
+  EXPECT_NE(a.best, c.best);
+}
+
+TEST(Gnmm, StallStopsEarly) {
+  const auto f = [](const Vector6d&) { return 1.0; };  // flat: never improves
+  GnmmSettings s;
+  s.stall_iterations = 20;
+  const GnmmResult r = Gnmm(s).maximize(f, Vector6d::Zero());
+  EXPECT_EQ(r.stop, GnmmStop::Stalled);
+  EXPECT_EQ(r.iterations, 20);
+}
+
+TEST(Gnmm, SettingsOutOfRangeAreRefused) {
+  GnmmSettings s;
+  s.vertices = 6;
+  EXPECT_THROW(Gnmm{s}, std::invalid_argument);
+  s = GnmmSettings{};
+  s.bounds[4] = 0;
+  EXPECT_THROW(Gnmm{s}, std::invalid_argument);
+  s = GnmmSettings{};
+  s.max_iterations = 0;
+  EXPECT_THROW(Gnmm{s}, std::invalid_argument);
+}

@@ -1,0 +1,161 @@
+// Registration against known transforms on synthetic scenes sampled like the paper's tilting
+// scanner (eq. 1, +-4 cm range noise): perturbed starts within the paper's big bounds
+// (+-1 m, +-8 deg), both directions, translation and angle tolerances.
+#include <gtest/gtest.h>
+
+#include <cstdio>
+#include <algorithm>
+#include <random>
+#include <vector>
+
+#include "cube_scan_matcher/core/defaults.h"
+#include "cube_scan_matcher/core/registration.h"
+#include "cube_scan_matcher/sim/tilting_scanner.h"
+
+using namespace cube_scan_matcher;
+
+namespace {
+
+struct Scans {
+  PointArray first, second;
+  Eigen::Isometry3d T_first_second;  // second-scan points -> first-scan frame (the truth)
+};
+
+// Two sweeps of the same scene from sensor poses 2.5 m and 12 deg of yaw apart. The first pose
+// has a yaw of 17 deg and a little roll and pitch: a robot is never exactly aligned with the
+// walls of a procedural world, and a scene whose planes are parallel to the cube grid is a
+// degenerate case for any grid method (J is flat within a cube).
+Scans makeScans(sim::SceneType type, std::uint64_t seed) {
+  const sim::Scene scene = sim::Scene::generate(type, seed);
+  const sim::ScannerModel model;
+  Eigen::Isometry3d body1 = Eigen::Isometry3d::Identity(), body2 = Eigen::Isometry3d::Identity();
+  body1.translation() = Eigen::Vector3d(5, 0.3, scene.groundHeight(5, 0.3) + 1.0);
+  body1.linear() = rotationFromRpy(0.012, -0.02, deg2rad(17));
+  Eigen::Isometry3d step = Eigen::Isometry3d::Identity();
+  step.translation() = Eigen::Vector3d(2.4, 0.6, 0.0);
+  step.linear() = rotationFromRpy(0.02, -0.015, deg2rad(12));
+  body2 = body1 * step;
+  body2.translation().z() = scene.groundHeight(body2.translation().x(), body2.translation().y()) + 1.05;
+  Eigen::Isometry3d mount = Eigen::Isometry3d::Identity();
+  mount.linear() = sim::sensorToBodyRotation();
+  std::mt19937_64 rng(seed);
+  Scans s;
+  s.first = sim::scan(scene, model, body1 * mount, rng);
+  s.second = sim::scan(scene, model, body2 * mount, rng);
+  s.T_first_second = (body1 * mount).inverse() * (body2 * mount);
+  return s;
+}
+
+struct Case {
+  sim::SceneType scene;
+  bool reverse;  // register first -> second instead of second -> first
+};
+
+class SyntheticRegistration : public ::testing::TestWithParam<Case> {};
+
+// Regression guard at the level measured today, from the paper's *small* initial errors
+// (+-0.25 m, +-2 deg): median error < 0.15 m / 0.30 deg, no trial beyond 0.30 m / 1 deg, and J
+// never below J at the guess. The target (3 cm / 0.3 deg from +-1 m / +-8 deg on every
+// trial) is NOT met on these synthetic scenes yet; see BENCHMARK.md for the measured rates.
+TEST_P(SyntheticRegistration, RecoversKnownTransformFromSmallInitialErrors) {
+  const Case c = GetParam();
+  const Scans s = makeScans(c.scene, 11);
+  const PointArray& ref = c.reverse ? s.second : s.first;
+  const PointArray& scan = c.reverse ? s.first : s.second;
+  const Eigen::Isometry3d truth = c.reverse ? s.T_first_second.inverse() : s.T_first_second;
+  ASSERT_GT(scan.size(), 20000u);
+
+  CubeRegistration reg(defaultSettings());
+  reg.setReference(ref);
+  std::mt19937_64 rng(5);
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  const Pose6 truth_pose = isometryToPose(truth);
+  std::vector<double> dts, das;
+  for (int trial = 0; trial < 6; ++trial) {
+    Pose6 guess = truth_pose;
+    for (int k = 0; k < 3; ++k) guess[k] += 0.25 * u(rng);
+    for (int k = 3; k < 6; ++k) guess[k] += deg2rad(2.0) * u(rng);
+    const RegistrationResult r = reg.align(scan, guess);
+    ASSERT_TRUE(r.ok()) << r.message;
+    const Eigen::Isometry3d err = truth.inverse() * r.transform;
+    const double dt = (r.transform.translation() - truth.translation()).norm();
+    const double da = rad2deg(Eigen::AngleAxisd(err.linear()).angle());
+    std::printf("[ trial    ] %s %d: %.3f m %.3f deg, %s\n", sim::toString(c.scene).c_str(), trial,
+                dt, da, r.message.c_str());
+    EXPECT_LT(dt, 0.30);
+    EXPECT_LT(da, 1.0);
+    EXPECT_GE(r.J, r.J_guess);
+    dts.push_back(dt);
+    das.push_back(da);
+  }
+  std::nth_element(dts.begin(), dts.begin() + 3, dts.end());
+  std::nth_element(das.begin(), das.begin() + 3, das.end());
+  EXPECT_LT(dts[3], 0.15);
+  EXPECT_LT(das[3], 0.30);
+}
+
+INSTANTIATE_TEST_SUITE_P(
+    Scenes, SyntheticRegistration,
+    ::testing::Values(Case{sim::SceneType::Urban, false}, Case{sim::SceneType::Urban, true},
+                      Case{sim::SceneType::Park, false}, Case{sim::SceneType::Park, true},
+                      Case{sim::SceneType::Natural, false}),
+    [](const ::testing::TestParamInfo<Case>& i) {
+      return sim::toString(i.param.scene) + (i.param.reverse ? "_reverse" : "_forward");
+    });
+
+TEST(Registration, PaperModeAlsoConverges) {
+  const Scans s = makeScans(sim::SceneType::Urban, 3);
+  CubeRegistration reg(RegistrationSettings::paper(0.5));
+  reg.setReference(s.first);
+  Pose6 guess = isometryToPose(s.T_first_second);
+  guess.head<3>() += Eigen::Vector3d(0.8, -0.6, 0.3);
+  guess[5] += deg2rad(-7);
+  const RegistrationResult r = reg.align(s.second, guess);
+  ASSERT_TRUE(r.ok());
+  EXPECT_LT((r.transform.translation() - s.T_first_second.translation()).norm(), 0.10);
+  EXPECT_EQ(r.iterations, 500);
+  EXPECT_EQ(r.points_used, s.second.size());  // the paper evaluates every point
+}
+
+TEST(Registration, BadInputsGiveAResultThatSaysSo) {
+  CubeRegistration reg(defaultSettings());
+  PointArray scan;
+  scan.push_back(1, 2, 3);
+  EXPECT_EQ(reg.align(scan, Pose6::Zero()).status, RegistrationStatus::NoReference);
+
+  PointArray ref;
+  for (int i = 0; i < 100; ++i) ref.push_back(float(i % 10), float(i / 10), 0.f);
+  reg.setReference(ref);
+  EXPECT_EQ(reg.align(PointArray{}, Pose6::Zero()).status, RegistrationStatus::EmptyScan);
+
+  PointArray far_away;
+  for (int i = 0; i < 100; ++i) far_away.push_back(500.f + float(i), 500.f, 500.f);
+  const RegistrationResult r = reg.align(far_away, Pose6::Zero());
+  EXPECT_EQ(r.status, RegistrationStatus::NoOverlap);
+  EXPECT_NE(r.message.find("overlap"), std::string::npos);
+}
+
+TEST(Registration, FailedReferenceKeepsThePreviousOne) {
+  CubeRegistration reg(defaultSettings());
+  PointArray ref;
+  for (int i = 0; i < 100; ++i) ref.push_back(float(i % 10), float(i / 10), 0.f);
+  reg.setReference(ref);
+  const std::size_t l = reg.grid().occupiedCount();
+  PointArray absurd = ref;
+  absurd.push_back(1e7f, 1e7f, 1e7f);
+  EXPECT_THROW(reg.setReference(absurd), CubeGridError);
+  EXPECT_TRUE(reg.hasReference());
+  EXPECT_EQ(reg.grid().occupiedCount(), l);
+}
+
+TEST(Registration, SettingsAreValidated) {
+  RegistrationSettings s = defaultSettings();
+  s.collapse_fraction = 2.0;
+  EXPECT_THROW(CubeRegistration{s}, std::invalid_argument);
+  s = defaultSettings();
+  s.refine.enabled = true;
+  s.refine.edge_fraction = 1.5;
+  EXPECT_THROW(CubeRegistration{s}, std::invalid_argument);
+}
+
+}  // namespace
