@@ -1,0 +1,33 @@
+#!/usr/bin/env bash
+# The README's test command: installs, builds and runs the whole test suite through CTest.
+# With DATA_DIR (a folder laid out like shared/data: sub-folders with pairs.txt), it also runs
+# the real-data accuracy check: the cube method with the default settings must succeed
+# (Es < 0.10 m and Ea < 1 deg) in at least 8 of 10 trials from +-1 m / +-8 deg on every pair.
+#   usage: scripts/test.sh [DATA_DIR]
+set -euo pipefail
+cd "$(dirname "$0")/.."
+DATA_DIR="${1:-}"
+if [ -n "$DATA_DIR" ] && [ ! -d "$DATA_DIR" ]; then
+  echo "test: DATA_DIR '$DATA_DIR' is not a directory" >&2
+  exit 2
+fi
+bash scripts/install_deps.sh
+bash scripts/build.sh
+export PATH=/usr/sbin:/usr/bin:/sbin:/bin:$PATH
+set +u  # ROS setup scripts read unset variables
+source build/devel/setup.bash
+set -u
+status=0
+if [ -n "$DATA_DIR" ]; then
+  echo "== real-data accuracy check on $DATA_DIR"
+  for d in "$DATA_DIR"/*/; do
+    [ -f "$d/pairs.txt" ] || continue
+    build/devel/lib/cube_scan_matcher/benchmark "$d" --methods cubes --trials 10 \
+      --require-success 8 --csv "build/accuracy_$(basename "$d").csv" 2>/dev/null || status=1
+  done
+else
+  echo "== real-data accuracy check NOT run: no DATA_DIR given (CI passes ../shared/data)"
+fi
+echo "== unit and integration tests (CTest)"
+(cd build && ctest --output-on-failure) || status=1
+exit $status
