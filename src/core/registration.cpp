@@ -73,6 +73,21 @@ void CubeRegistration::setReference(const PointArray& reference) {
   has_reference_ = true;
 }
 
+const PointArray& CubeRegistration::prepareScan(const PointArray& scan,
+                                               PointArray& storage) const {
+  if (settings_.collapse_fraction <= 0.0) return scan;
+  storage = collapseToVoxels(scan, settings_.collapse_fraction * grid_.edge());
+  return storage;
+}
+
+int CubeRegistration::score(const PointArray& scan, const Pose6& pose) const {
+  if (!has_reference_) throw std::logic_error("CubeRegistration::score before setReference");
+  if (scan.empty()) return 0;
+  PointArray storage;
+  CoincidenceObjective objective(grid_, prepareScan(scan, storage));
+  return objective(pose);
+}
+
 RegistrationResult CubeRegistration::align(const PointArray& scan, const Pose6& guess) const {
   const auto start = std::chrono::steady_clock::now();
   RegistrationResult res;
@@ -89,12 +104,8 @@ RegistrationResult CubeRegistration::align(const PointArray& scan, const Pose6& 
   res.reference_cubes = grid_.occupiedCount();
   if (scan.empty()) return finish(RegistrationStatus::EmptyScan, "scan has no valid point");
 
-  PointArray collapsed;
-  const PointArray* points = &scan;
-  if (settings_.collapse_fraction > 0.0) {
-    collapsed = collapseToVoxels(scan, settings_.collapse_fraction * grid_.edge());
-    points = &collapsed;
-  }
+  PointArray storage;
+  const PointArray* points = &prepareScan(scan, storage);
   res.points_used = points->size();
 
   CoincidenceObjective objective(grid_, *points);
@@ -108,9 +119,9 @@ RegistrationResult CubeRegistration::align(const PointArray& scan, const Pose6& 
   res.restarts = g.restarts;
   res.stop = g.stop;
 
-  // Refine stage (not in the paper): fine cubes in a small box around the coarse result. The
-  // fine grid's edge is inside the cell size of the collapse voxel only if collapse_fraction
-  // is small enough; the same collapsed points are used for simplicity and speed.
+  // Refine stage (not in the paper): GNMM on the fine grids in a small box around the coarse
+  // result, maximising the sum of their J. It evaluates the same (collapsed) points; the
+  // default collapse voxel, E/4, is half a fine cube.
   if (settings_.refine.enabled && res.J > 0 && !fine_grids_.empty()) {
     std::vector<CoincidenceObjective> fine;
     fine.reserve(fine_grids_.size());

@@ -16,6 +16,7 @@
 
 #include "cloud_io.h"
 #include "cube_scan_matcher/core/filters.h"
+#include "cube_scan_matcher/core/defaults.h"
 #include "cube_scan_matcher/core/registration.h"
 #include "dataset.h"
 #include "peer_methods.h"
@@ -81,7 +82,7 @@ struct Bounds {
 
 int main(int argc, char** argv) {
   std::vector<std::string> args(argv + 1, argv + argc);
-  RegistrationSettings cube_settings = tools::defaultSettings();
+  RegistrationSettings cube_settings = defaultSettings();
   RangeFilterSettings filter;
   std::string dir, csv_path = "benchmark.csv";
   int trials = 25, require = -1;
@@ -166,13 +167,7 @@ int main(int argc, char** argv) {
         est = r.transform;
         row.evaluations = r.evaluations;
         row.j = r.J;
-        // J at the reference pose, for comparison (untimed).
-        CubeRegistration probe(s);
-        probe.setReference(d.tgt_pts);
-        RegistrationSettings one = s;
-        one.gnmm.max_iterations = 1;
-        probe.setSettings(one);
-        row.j_ref = probe.align(d.src_pts, isometryToPose(d.ref)).J_guess;
+        row.j_ref = reg.score(d.src_pts, isometryToPose(d.ref));  // untimed, for comparison
       });
     };
     for (const auto& m : methods) {

@@ -7,6 +7,7 @@
 
 #include "cloud_io.h"
 #include "cube_scan_matcher/core/filters.h"
+#include "cube_scan_matcher/core/defaults.h"
 #include "cube_scan_matcher/core/registration.h"
 #include "settings_cli.h"
 
@@ -25,7 +26,7 @@ void usage(std::ostream& os) {
 
 int main(int argc, char** argv) {
   std::vector<std::string> args(argv + 1, argv + argc);
-  RegistrationSettings settings = tools::defaultSettings();
+  RegistrationSettings settings = defaultSettings();
   RangeFilterSettings filter;
   Pose6 guess = Pose6::Zero();
   std::vector<std::string> files;

@@ -7,8 +7,6 @@
 
 namespace cube_scan_matcher::tools {
 
-RegistrationSettings defaultSettings() { return cube_scan_matcher::defaultSettings(); }
-
 std::string algorithmOptionsHelp() {
   const RegistrationSettings d = defaultSettings();
   const RangeFilterSettings f;

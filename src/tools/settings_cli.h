@@ -20,7 +20,4 @@ bool parseAlgorithmOption(const std::vector<std::string>& args, std::size_t& i,
 /// Reads a number or throws std::invalid_argument naming the option.
 double parseNumber(const std::string& option, const std::string& value);
 
-/// The package's default settings (the fast mode documented in README and BENCHMARK.md).
-RegistrationSettings defaultSettings();
-
 }  // namespace cube_scan_matcher::tools

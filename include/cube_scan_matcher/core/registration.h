@@ -94,12 +94,19 @@ class CubeRegistration {
   /// Registers `scan` to the reference around `guess` (scan -> reference).
   RegistrationResult align(const PointArray& scan, const Pose6& guess) const;
 
+  /// J of `scan` at `pose` on the coarse grid, with the same scan preparation as align()
+  /// (collapsing). Needs a reference; returns 0 for an empty scan.
+  int score(const PointArray& scan, const Pose6& pose) const;
+
   const RegistrationSettings& settings() const { return settings_; }
   /// Takes effect at the next setReference()/align(); validates. A new cube_edge or max_cubes
   /// needs a new setReference() (the grid is rebuilt only there).
   void setSettings(const RegistrationSettings& settings);
 
  private:
+  /// The points the objective evaluates: `scan` itself, or its collapsed copy in `storage`.
+  const PointArray& prepareScan(const PointArray& scan, PointArray& storage) const;
+
   RegistrationSettings settings_;
   CubeGrid grid_;
   std::vector<CubeGrid> fine_grids_;
