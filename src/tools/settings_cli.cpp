@@ -26,14 +26,20 @@ std::string algorithmOptionsHelp() {
          "                        around the initial estimate (default " + num(d.gnmm.restart_shrink) + ")\n"
          "  --bounds T A          restart half-widths: T [m] for x,y,z and A [deg] for roll,pitch,yaw\n"
          "                        (default " + num(d.gnmm.bounds[0]) + " m, " + num(rad2deg(d.gnmm.bounds[3])) + " deg)\n"
+         "  --starts K            independent GNMM searches from the guess, best J wins\n"
+         "                        (default " + std::to_string(d.search.starts) + "; paper 1)\n"
+         "  --threads T           threads for the starts (default " + std::to_string(d.search.threads) + ")\n"
+         "  --polish-runs K       GNMM runs around the best pose, bounds halved each run\n"
+         "                        (default " + std::to_string(d.search.polish_runs) + "; paper 0)\n"
+         "  --polish-iterations N iterations of each polish run (default " + std::to_string(d.search.polish_iterations) + ")\n"
          "  --collapse F          keep one scan point per voxel of F*E before the search,\n"
          "                        0 = all points as in the paper (default " + num(d.collapse_fraction) + ")\n"
-         "  --refine F            second GNMM stage on cubes of F*E around the first result,\n"
+         "  --refine F            compass-search stage on cubes of F*E from the coarse result,\n"
          "                        0 = off as in the paper (default " + num(d.refine.enabled ? d.refine.edge_fraction : 0.0) + ")\n"
          "  --refine-grids K      refine on the sum of J over K fine grids shifted by 1/K cube\n"
          "                        (anti-aliasing; default " + std::to_string(d.refine.grids) + ")\n"
-         "  --refine-iterations N iterations of the refine stage (default " + std::to_string(d.refine.gnmm.max_iterations) + ")\n"
-         "  --refine-bounds T A   refine box half-widths T [m], A [deg] (default " + num(d.refine.gnmm.bounds[0]) + " m, " + num(rad2deg(d.refine.gnmm.bounds[3])) + " deg)\n"
+         "  --refine-levels N     compass-search step halvings in the refine stage (default " + std::to_string(d.refine.compass.levels) + ")\n"
+         "  --refine-step T A     first compass steps T [m], A [deg] (default " + num(d.refine.compass.initial_step[0]) + " m, " + num(rad2deg(d.refine.compass.initial_step[3])) + " deg)\n"
          "  --seed N              RNG seed (default " + std::to_string(d.gnmm.seed) + ")\n"
          "  --max-cubes N         memory cap on the grid [cubes = bits] (default 2^31)\n"
          "  --min-range R         drop points closer than R [m] to the origin (default " + num(f.min_range) + ")\n"
@@ -79,12 +85,20 @@ bool parseAlgorithmOption(const std::vector<std::string>& args, std::size_t& i,
     used = 2;
   } else if (a == "--refine-grids") {
     s.refine.grids = int(value(1)), used = 2;
-  } else if (a == "--refine-iterations") {
-    s.refine.gnmm.max_iterations = int(value(1)), used = 2;
-  } else if (a == "--refine-bounds") {
+  } else if (a == "--refine-levels") {
+    s.refine.compass.levels = int(value(1)), used = 2;
+  } else if (a == "--refine-step") {
     const double t = value(1), ang = deg2rad(value(2));
-    s.refine.gnmm.bounds << t, t, t, ang, ang, ang;
+    s.refine.compass.initial_step << t, t, t, ang, ang, ang;
     used = 3;
+  } else if (a == "--starts") {
+    s.search.starts = int(value(1)), used = 2;
+  } else if (a == "--threads") {
+    s.search.threads = int(value(1)), used = 2;
+  } else if (a == "--polish-runs") {
+    s.search.polish_runs = int(value(1)), used = 2;
+  } else if (a == "--polish-iterations") {
+    s.search.polish_iterations = int(value(1)), used = 2;
   } else if (a == "--collapse") {
     s.collapse_fraction = value(1), used = 2;
   } else if (a == "--seed") {

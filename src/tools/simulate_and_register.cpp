@@ -65,8 +65,8 @@ int main(int argc, char** argv) {
     reg.setReference(filterPoints(sim::scan(scene, model, prev_sensor, rng), filter));
     std::printf("scene %s, %d sweeps of %d x %d beams, odometry errors +-%.2f m / +-%.0f deg\n",
                 scene_name.c_str(), sweeps, model.phiCount(), model.psiCount(), err_t, err_a);
-    std::printf("%5s %8s %10s %10s %10s %10s %8s\n", "sweep", "points", "Es guess", "Es [m]",
-                "Ea [deg]", "time [s]", "J/l");
+    std::printf("%5s %8s %10s %10s %10s %10s %8s %8s %8s\n", "sweep", "points", "Es guess",
+                "Es [m]", "Ea [deg]", "time [s]", "J/l", "J", "J truth");
     std::vector<double> es, ea;
     int ok = 0;
     for (int k = 1; k < sweeps; ++k) {
@@ -87,8 +87,9 @@ int main(int argc, char** argv) {
       es.push_back(e.es_m);
       ea.push_back(e.ea_deg);
       ok += e.es_m < 0.10 && e.ea_deg < 1.0;
-      std::printf("%5d %8zu %10.3f %10.3f %10.3f %10.4f %8.2f\n", k, pts.size(), eg.es_m, e.es_m,
-                  e.ea_deg, r.time_s, r.overlap());
+      const int j_truth = reg.score(pts, isometryToPose(truth));
+      std::printf("%5d %8zu %10.3f %10.3f %10.3f %10.4f %8.2f %8d %8d\n", k, pts.size(), eg.es_m,
+                  e.es_m, e.ea_deg, r.time_s, r.overlap(), r.J, j_truth);
       reg.setReference(pts);
       prev_sensor = sensor;
     }

@@ -53,11 +53,11 @@ struct Case {
 
 class SyntheticRegistration : public ::testing::TestWithParam<Case> {};
 
-// Regression guard at the level measured today, from the paper's *small* initial errors
-// (+-0.25 m, +-2 deg): median error < 0.15 m / 0.30 deg, no trial beyond 0.30 m / 1 deg, and J
-// never below J at the guess. The target (3 cm / 0.3 deg from +-1 m / +-8 deg on every
-// trial) is NOT met on these synthetic scenes yet; see BENCHMARK.md for the measured rates.
-TEST_P(SyntheticRegistration, RecoversKnownTransformFromSmallInitialErrors) {
+// From the paper's *big* initial errors (+-1 m, +-8 deg per parameter), both directions, all
+// four scenes: median error < 4 cm / 0.3 deg per scene, no trial beyond 5 cm / 0.5 deg, and J
+// never below J at the guess. (Target 3 cm: met by the median over all scenes, 1.5 cm; the
+// natural scene's median is 3.4 cm with the sensor's +-4 cm noise.)
+TEST_P(SyntheticRegistration, RecoversKnownTransformFromBigInitialErrors) {
   const Case c = GetParam();
   const Scans s = makeScans(c.scene, 11);
   const PointArray& ref = c.reverse ? s.second : s.first;
@@ -73,8 +73,8 @@ TEST_P(SyntheticRegistration, RecoversKnownTransformFromSmallInitialErrors) {
   std::vector<double> dts, das;
   for (int trial = 0; trial < 6; ++trial) {
     Pose6 guess = truth_pose;
-    for (int k = 0; k < 3; ++k) guess[k] += 0.25 * u(rng);
-    for (int k = 3; k < 6; ++k) guess[k] += deg2rad(2.0) * u(rng);
+    for (int k = 0; k < 3; ++k) guess[k] += 1.0 * u(rng);
+    for (int k = 3; k < 6; ++k) guess[k] += deg2rad(8.0) * u(rng);
     const RegistrationResult r = reg.align(scan, guess);
     ASSERT_TRUE(r.ok()) << r.message;
     const Eigen::Isometry3d err = truth.inverse() * r.transform;
@@ -82,23 +82,25 @@ TEST_P(SyntheticRegistration, RecoversKnownTransformFromSmallInitialErrors) {
     const double da = rad2deg(Eigen::AngleAxisd(err.linear()).angle());
     std::printf("[ trial    ] %s %d: %.3f m %.3f deg, %s\n", sim::toString(c.scene).c_str(), trial,
                 dt, da, r.message.c_str());
-    EXPECT_LT(dt, 0.30);
-    EXPECT_LT(da, 1.0);
+    EXPECT_LT(dt, 0.05);
+    EXPECT_LT(da, 0.5);
     EXPECT_GE(r.J, r.J_guess);
     dts.push_back(dt);
     das.push_back(da);
   }
   std::nth_element(dts.begin(), dts.begin() + 3, dts.end());
   std::nth_element(das.begin(), das.begin() + 3, das.end());
-  EXPECT_LT(dts[3], 0.15);
+  EXPECT_LT(dts[3], 0.04);
   EXPECT_LT(das[3], 0.30);
 }
 
 INSTANTIATE_TEST_SUITE_P(
     Scenes, SyntheticRegistration,
-    ::testing::Values(Case{sim::SceneType::Urban, false}, Case{sim::SceneType::Urban, true},
+    ::testing::Values(Case{sim::SceneType::Hall, false}, Case{sim::SceneType::Hall, true},
+                      Case{sim::SceneType::Urban, false}, Case{sim::SceneType::Urban, true},
                       Case{sim::SceneType::Park, false}, Case{sim::SceneType::Park, true},
-                      Case{sim::SceneType::Natural, false}),
+                      Case{sim::SceneType::Natural, false},
+                      Case{sim::SceneType::Natural, true}),
     [](const ::testing::TestParamInfo<Case>& i) {
       return sim::toString(i.param.scene) + (i.param.reverse ? "_reverse" : "_forward");
     });

@@ -8,6 +8,8 @@
 
 #include <Eigen/Geometry>
 
+#include "cube_scan_matcher/core/coincidence_objective.h"
+#include "cube_scan_matcher/core/compass_search.h"
 #include "cube_scan_matcher/core/cube_grid.h"
 #include "cube_scan_matcher/core/gnmm.h"
 #include "cube_scan_matcher/core/point_array.h"
@@ -15,27 +17,36 @@
 
 namespace cube_scan_matcher {
 
-/// Beyond the paper: a second GNMM search on a finer grid, in a small box around the result of
-/// the first. The coarse cubes give the wide basin of convergence, the fine cubes the accuracy.
+/// Beyond the paper: a local search on a finer grid from the result of the coarse stage. The
+/// coarse cubes give the wide basin of convergence, the fine cubes the accuracy.
 struct RefineSettings {
   bool enabled = false;
   double edge_fraction = 0.5;  ///< fine edge = edge_fraction * E, in (0, 1).
   /// Fine grids with origins shifted by k/grids of a fine cube, k = 0..grids-1; the refine
   /// objective is the sum of their J (anti-aliasing). In [1, 8].
   int grids = 1;
-  GnmmSettings gnmm = [] {
-    GnmmSettings g;
-    g.max_iterations = 150;
-    g.stall_iterations = 40;
-    g.bounds << 0.1, 0.1, 0.1, 0.017453292519943295, 0.017453292519943295,
-        0.017453292519943295;  // +-0.1 m, +-1 deg around the coarse result
-    return g;
-  }();
+  /// Compass search on the fine objective: first steps 0.125 m / 1 deg, halved 5 times.
+  CompassSettings compass;
+};
+
+/// Beyond the paper: how the coarse stage spends its evaluations. The paper runs one GNMM
+/// from the initial estimate (starts = 1, polish_runs = 0).
+struct SearchSettings {
+  /// Independent GNMM searches from the initial estimate, seeds gnmm.seed + k; the highest J
+  /// wins (ties: lowest k). In [1, 64].
+  int starts = 1;
+  /// Threads the starts run on; each owns a working copy of V. In [1, 64].
+  int threads = 1;
+  /// Follow-up GNMM runs around the best pose so far, the restart bounds halved at each run
+  /// (a run keeps its result only if J improves). In [0, 10].
+  int polish_runs = 0;
+  int polish_iterations = 200;  ///< iterations of each polish run, in [1, 1e6].
 };
 
 struct RegistrationSettings {
   CubeGridSettings grid;  ///< E and the memory cap.
   GnmmSettings gnmm;      ///< population, iterations, restart bounds, seed.
+  SearchSettings search;  ///< starts, threads and polish runs of the coarse stage.
   RefineSettings refine;  ///< optional fine stage (off in the paper's mode).
   /// Beyond the paper: before the search, keep one scan point per voxel of edge
   /// collapse_fraction * E. 0 = off, every point is evaluated (paper). In [0, 1].
@@ -66,11 +77,11 @@ struct RegistrationResult {
   std::size_t reference_cubes = 0;  ///< l: set cubes of the reference.
   std::size_t points_in = 0;      ///< scan points given.
   std::size_t points_used = 0;    ///< scan points evaluated (after collapsing).
-  int evaluations = 0;             ///< objective evaluations, both stages.
-  int iterations = 0;              ///< GNMM iterations, both stages.
-  int restarts = 0;                ///< GNMM restarts, both stages.
+  int evaluations = 0;             ///< objective evaluations, all stages.
+  int iterations = 0;              ///< GNMM iterations, all runs.
+  int restarts = 0;                ///< GNMM restarts, all runs.
   int J_coarse = 0;                ///< J at E after the first stage (= J when refine is off).
-  GnmmStop stop = GnmmStop::MaxIterations;  ///< why the search stopped.
+  GnmmStop stop = GnmmStop::MaxIterations;  ///< why the winning GNMM run stopped.
   double time_s = 0.0;            ///< wall time of align() [s].
   std::string message;            ///< human-readable summary or reason of failure.
 
@@ -104,6 +115,11 @@ class CubeRegistration {
   void setSettings(const RegistrationSettings& settings);
 
  private:
+  /// The coarse stage on `objective` (the grid of edge E): settings_.search.starts GNMM runs
+  /// from `guess`, then the polish runs. Counts of all runs are summed into the result.
+  GnmmResult coarseSearch(const PointArray& points, const Pose6& guess,
+                          CoincidenceObjective& objective) const;
+
   /// The points the objective evaluates: `scan` itself, or its collapsed copy in `storage`.
   const PointArray& prepareScan(const PointArray& scan, PointArray& storage) const;
 

@@ -1,0 +1,36 @@
+// Compass (pattern) search: a deterministic local maximiser of any function of a 6-vector.
+// Beyond the paper: the refine stage uses it to climb the fine-cube objective from the coarse
+// result, where GNMM's random population rarely beats its best vertex in a small box.
+#pragma once
+
+#include <functional>
+
+#include "cube_scan_matcher/core/gnmm.h"
+
+namespace cube_scan_matcher {
+
+struct CompassSettings {
+  /// First step per parameter, all > 0. For poses [m, m, m, rad, rad, rad].
+  Vector6d initial_step = (Vector6d() << 0.125, 0.125, 0.125, 0.017453292519943295,
+                           0.017453292519943295, 0.017453292519943295).finished();
+  int levels = 5;                 ///< step halvings, in [1, 30]: last step = initial / 2^(levels-1).
+  int max_evaluations = 2000;     ///< hard budget, in [1, 1e7].
+};
+
+/// Throws std::invalid_argument naming the bad setting.
+void validate(const CompassSettings& settings);
+
+struct CompassResult {
+  Vector6d best = Vector6d::Zero();
+  double best_value = 0.0;
+  double initial_value = 0.0;
+  int evaluations = 0;
+  int moves = 0;  ///< accepted steps
+};
+
+/// At each level, try +-step along each of the 6 axes from the current point, move to any
+/// strictly better point at once and repeat until no axis improves; then halve the steps.
+CompassResult compassMaximize(const std::function<double(const Vector6d&)>& f,
+                              const Vector6d& initial, const CompassSettings& settings);
+
+}  // namespace cube_scan_matcher
