@@ -13,6 +13,10 @@ PKGS=(
   ros-message-runtime libdynamic-reconfigure-config-init-mutex-dev python3-dynamic-reconfigure
   libdiagnostic-updater-dev librostest-dev python3-rostest python3-roslaunch python3-rosmaster
   python3-rostopic rosbash librosbag-dev python3-rosbag python3-matplotlib
+  libnav-msgs-dev libstd-srvs-dev libsensor-msgs-dev libgeometry-msgs-dev libdiagnostic-msgs-dev
+  python3-rospy python3-nav-msgs python3-sensor-msgs python3-geometry-msgs python3-std-srvs
+  python3-tf2-ros python3-diagnostic-msgs python3-numpy
+  rviz xvfb xauth imagemagick
 )
 missing=()
 for p in "${PKGS[@]}"; do

@@ -1,0 +1,79 @@
+// Online scan-to-previous-scan registration with a pose chain: the ROS-free heart of the
+// nodelet. Each scan (in the robot's base frame) is registered to the current reference scan
+// around the odometry increment, gated, chained onto the reference's pose, and becomes the
+// next reference.
+#pragma once
+
+#include <optional>
+#include <string>
+
+#include <Eigen/Geometry>
+
+#include "cube_scan_matcher/core/acceptance_gate.h"
+#include "cube_scan_matcher/core/defaults.h"
+#include "cube_scan_matcher/core/registration.h"
+
+namespace cube_scan_matcher {
+
+struct OnlineMatcherSettings {
+  RegistrationSettings registration = defaultSettings();
+  GateSettings gate;
+  /// After this many consecutive rejected scans the step reports `rejection_alarm`. >= 1.
+  int max_consecutive_rejections = 5;
+};
+
+/// Throws std::invalid_argument naming the bad setting.
+void validate(const OnlineMatcherSettings& settings);
+
+/// What happened to one scan.
+struct OnlineStep {
+  GateReason reason = GateReason::FirstScan;
+  bool registered = false;         ///< align() ran (a reference existed and the scan had points).
+  bool accepted = false;           ///< the registration result gave the increment.
+  bool odometry_guess = false;     ///< the guess came from odometry at both stamps (else identity).
+  bool reference_updated = false;  ///< this scan is now the reference.
+  bool time_reset = false;         ///< time went backwards: state was reset before this scan.
+  bool rejection_alarm = false;    ///< consecutive rejections >= max_consecutive_rejections.
+  int consecutive_rejections = 0;
+  RegistrationResult result;       ///< valid when registered.
+  Pose6 guess = Pose6::Zero();     ///< scan -> reference guess [m, rad].
+  Pose6 correction = Pose6::Zero();  ///< guess^-1 * result [m, rad] (zero if not registered).
+  Eigen::Isometry3d increment = Eigen::Isometry3d::Identity();  ///< scan -> reference, used.
+  Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();       ///< T_map_base of this scan.
+  std::string message;             ///< why, for logs.
+};
+
+class OnlineMatcher {
+ public:
+  explicit OnlineMatcher(const OnlineMatcherSettings& settings);  // validates
+
+  /// `points`: the scan in the base frame at `stamp` [s] (finite points). `odom`: T_odom_base
+  /// at `stamp` when known. The first scan's pose is its odometry pose (map = odom there), or
+  /// identity without odometry.
+  OnlineStep process(const PointArray& points, double stamp,
+                     const std::optional<Eigen::Isometry3d>& odom);
+
+  /// Forgets the reference, the pose chain and the rejection count.
+  void reset();
+  /// Takes effect at the next scan (a new cube edge rebuilds the reference grid there).
+  void setSettings(const OnlineMatcherSettings& settings);  // validates
+  const OnlineMatcherSettings& settings() const { return settings_; }
+  bool hasReference() const { return registration_.hasReference(); }
+  /// Stamp of the last processed scan [s]; nullopt after reset.
+  std::optional<double> lastStamp() const { return last_stamp_; }
+  /// Pose of the last processed scan in the map frame.
+  const Eigen::Isometry3d& lastPose() const { return last_pose_; }
+
+ private:
+  OnlineMatcherSettings settings_;
+  bool settings_changed_ = false;
+  CubeRegistration registration_;
+  PointArray reference_points_;  // kept to rebuild the grid when the cube edge changes
+  Eigen::Isometry3d reference_pose_ = Eigen::Isometry3d::Identity();  // T_map_base(reference)
+  std::optional<Eigen::Isometry3d> reference_odom_;                  // T_odom_base(reference)
+  std::optional<double> last_stamp_;
+  Eigen::Isometry3d last_pose_ = Eigen::Isometry3d::Identity();
+  int consecutive_rejections_ = 0;
+};
+
+}  // namespace cube_scan_matcher

@@ -1,0 +1,31 @@
+// sensor_msgs/PointCloud2 <-> the core's PointArray. Reads float32 and float64 x/y/z, checks
+// the message layout before touching its bytes, and never crashes on a malformed cloud.
+#pragma once
+
+#include <stdexcept>
+#include <string>
+
+#include <Eigen/Geometry>
+#include <sensor_msgs/PointCloud2.h>
+
+#include "cube_scan_matcher/core/point_array.h"
+
+namespace cube_scan_matcher {
+
+/// A cloud that cannot be read (no x/y/z field, unsupported type, truncated data); what()
+/// says which.
+class CloudError : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
+/// All width * height points of `cloud`, NaN included, transformed by `transform` (into the
+/// frame the caller wants). Throws CloudError.
+PointArray fromCloud(const sensor_msgs::PointCloud2& cloud,
+                     const Eigen::Isometry3d& transform = Eigen::Isometry3d::Identity());
+
+/// A dense float32 x/y/z cloud of `points` transformed by `transform`.
+sensor_msgs::PointCloud2 toCloud(const PointArray& points, const Eigen::Isometry3d& transform,
+                                 const std_msgs::Header& header);
+
+}  // namespace cube_scan_matcher

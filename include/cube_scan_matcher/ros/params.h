@@ -1,0 +1,59 @@
+// Every parameter of ScanMatcherNodelet, read and validated in one place. Out-of-range values
+// raise ParamError naming the parameter; the nodelet refuses to start with it. The same names,
+// units and defaults are in config/scan_matcher.yaml, cfg/ScanMatcher.cfg and the README.
+#pragma once
+
+#include <stdexcept>
+#include <string>
+
+#include <ros/node_handle.h>
+
+#include "cube_scan_matcher/ScanMatcherConfig.h"
+#include "cube_scan_matcher/core/filters.h"
+#include "cube_scan_matcher/core/online_matcher.h"
+
+namespace cube_scan_matcher {
+
+/// A parameter out of range or of the wrong type; what() names it.
+class ParamError : public std::invalid_argument {
+ public:
+  using std::invalid_argument::invalid_argument;
+};
+
+struct NodeParams {
+  // Frames.
+  std::string base_frame = "base_link";  ///< robot frame the scans are registered in.
+  std::string odom_frame = "odom";       ///< frame of the DGPS/IMU odometry (initial guess).
+  std::string map_frame = "map";         ///< frame of the published poses and clouds.
+  // tf.
+  double tf_timeout = 0.1;        ///< [s] bounded wait for each tf lookup, in [0, 10].
+  bool skip_without_tf = false;   ///< missing_tf_policy: "skip" (true) or "identity" (false).
+  bool publish_tf = false;        ///< publish map_frame -> odom_frame (REP-105).
+  // Input and outputs.
+  int queue_size = 1;             ///< subscriber queue, in [1, 100].
+  int path_max_length = 10000;    ///< poses kept in ~path, in [1, 1e6].
+  RangeFilterSettings filter;     ///< min_range, max_range [m] around the base_frame origin.
+  // Covariance of the published pose (diagonal, standard deviations).
+  double sigma_translation = 0.05;   ///< [m] of an accepted registration.
+  double sigma_rotation = 0.5;       ///< [deg] of an accepted registration.
+  double rejected_sigma_scale = 10;  ///< sigmas times this for an odometry-propagated scan.
+  // Diagnostics.
+  double min_rate = 0.05;         ///< [Hz] input rate below this is a WARN.
+  double max_rate = 100.0;        ///< [Hz] input rate above this is a WARN.
+  double max_latency = 1.0;       ///< [s] processing latency above this is a WARN.
+  // The algorithm and the gate (live through dynamic_reconfigure).
+  OnlineMatcherSettings matcher;
+};
+
+/// Reads every parameter from the private node handle, with defaults for those not set.
+/// Throws ParamError naming the first bad one.
+NodeParams loadParams(const ros::NodeHandle& pnh);
+
+/// Applies the live parameters of a dynamic_reconfigure request to `params.matcher`. Throws
+/// ParamError if the combination is invalid (params unchanged then).
+void applyConfig(const ScanMatcherConfig& config, NodeParams& params);
+
+/// The live parameters of `params` as a dynamic_reconfigure config.
+ScanMatcherConfig toConfig(const NodeParams& params);
+
+}  // namespace cube_scan_matcher

@@ -1,0 +1,75 @@
+// ScanMatcherNodelet: the ROS face of the package. A thin layer over core/online_matcher.h:
+// it reads clouds and tf, calls the core, and publishes pose, odometry, path, registered cloud,
+// status, optional tf and diagnostics. Topics, frames and parameters: README.md.
+#pragma once
+
+#include <deque>
+#include <memory>
+#include <mutex>
+#include <optional>
+
+#include <diagnostic_updater/diagnostic_updater.h>
+#include <diagnostic_updater/update_functions.h>
+#include <dynamic_reconfigure/server.h>
+#include <nav_msgs/Path.h>
+#include <nodelet/nodelet.h>
+#include <ros/ros.h>
+#include <sensor_msgs/PointCloud2.h>
+#include <std_srvs/Trigger.h>
+#include <tf2_ros/buffer.h>
+#include <tf2_ros/transform_broadcaster.h>
+#include <tf2_ros/transform_listener.h>
+
+#include "cube_scan_matcher/ScanMatcherConfig.h"
+#include "cube_scan_matcher/core/online_matcher.h"
+#include "cube_scan_matcher/ros/params.h"
+
+namespace cube_scan_matcher {
+
+class ScanMatcherNodelet : public nodelet::Nodelet {
+ public:
+  ScanMatcherNodelet() = default;
+  ~ScanMatcherNodelet() override;
+
+ private:
+  void onInit() override;
+  void cloudCallback(const sensor_msgs::PointCloud2ConstPtr& msg);
+  /// The work of cloudCallback, under the state mutex; may throw.
+  void processCloud(const sensor_msgs::PointCloud2& msg, double received_wall);
+  bool resetService(std_srvs::Trigger::Request& req, std_srvs::Trigger::Response& res);
+  void reconfigure(ScanMatcherConfig& config, uint32_t level);
+  /// T_target_source at `stamp`, waiting at most ~tf_timeout; nullopt (and counted) on failure.
+  std::optional<Eigen::Isometry3d> lookup(const std::string& target, const std::string& source,
+                                          const ros::Time& stamp, std::string& error);
+  void resetState(const std::string& why);
+  void diagnose(diagnostic_updater::DiagnosticStatusWrapper& stat);
+
+  NodeParams params_;
+  std::unique_ptr<OnlineMatcher> matcher_;
+  std::mutex mutex_;  // guards everything below: callbacks may run on several manager threads
+
+  std::unique_ptr<tf2_ros::Buffer> tf_buffer_;
+  std::unique_ptr<tf2_ros::TransformListener> tf_listener_;
+  std::unique_ptr<tf2_ros::TransformBroadcaster> tf_broadcaster_;
+  ros::Subscriber cloud_sub_;
+  ros::Publisher pose_pub_, odom_pub_, path_pub_, cloud_pub_, status_pub_;
+  ros::ServiceServer reset_srv_;
+  std::unique_ptr<dynamic_reconfigure::Server<ScanMatcherConfig>> reconfigure_server_;
+  boost::recursive_mutex reconfigure_mutex_;  // dynamic_reconfigure needs a boost mutex
+  std::unique_ptr<diagnostic_updater::Updater> updater_;
+  std::unique_ptr<diagnostic_updater::FrequencyStatus> rate_status_;
+  double min_rate_ = 0.0, max_rate_ = 0.0;  // FrequencyStatus keeps references to these
+  ros::Timer diagnostics_timer_;
+
+  nav_msgs::Path path_;
+  std::optional<std::uint32_t> last_seq_;
+  std::optional<ros::Time> last_stamp_;
+  std::uint32_t dropped_ = 0, rejected_ = 0, tf_failures_ = 0, processed_ = 0;
+  std::uint32_t bad_input_ = 0, consecutive_rejections_ = 0;
+  double last_latency_ = 0.0;
+  std::deque<double> latencies_;  // last latencies [s], for diagnostics
+  bool initialised_ = false;
+  std::string init_error_;
+};
+
+}  // namespace cube_scan_matcher

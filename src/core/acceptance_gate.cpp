@@ -1,0 +1,50 @@
+#include "cube_scan_matcher/core/acceptance_gate.h"
+
+#include <cmath>
+#include <stdexcept>
+
+namespace cube_scan_matcher {
+
+std::string toString(GateReason reason) {
+  switch (reason) {
+    case GateReason::Accepted: return "accepted";
+    case GateReason::FirstScan: return "first_scan";
+    case GateReason::LowOverlap: return "low_overlap";
+    case GateReason::NoGain: return "no_gain";
+    case GateReason::CorrectionTooLarge: return "correction_too_large";
+    case GateReason::RegistrationFailed: return "registration_failed";
+    case GateReason::BadReference: return "bad_reference";
+    case GateReason::SkippedNoTf: return "skipped_no_tf";
+    case GateReason::BadInput: return "bad_input";
+  }
+  return "unknown";
+}
+
+void validate(const GateSettings& s) {
+  if (!(s.min_overlap >= 0.0 && s.min_overlap <= 1.0))
+    throw std::invalid_argument("min_overlap must be in [0, 1], got " + std::to_string(s.min_overlap));
+  if (s.min_j_gain < 0)
+    throw std::invalid_argument("min_j_gain must be >= 0, got " + std::to_string(s.min_j_gain));
+  if (!(s.max_correction_m > 0.0 && std::isfinite(s.max_correction_m)))
+    throw std::invalid_argument("max_correction_translation must be > 0 m");
+  if (!(s.max_correction_rad > 0.0 && std::isfinite(s.max_correction_rad)))
+    throw std::invalid_argument("max_correction_rotation must be > 0");
+}
+
+Pose6 correctionFromGuess(const Pose6& guess, const Pose6& result) {
+  return isometryToPose(poseToIsometry(guess).inverse() * poseToIsometry(result));
+}
+
+GateReason gate(const RegistrationResult& r, const Pose6& guess, const GateSettings& s) {
+  if (!r.ok()) return GateReason::RegistrationFailed;
+  if (r.overlap() < s.min_overlap) return GateReason::LowOverlap;
+  if (r.J < r.J_guess + s.min_j_gain) return GateReason::NoGain;
+  const Eigen::Isometry3d c = poseToIsometry(guess).inverse() * r.transform;
+  if (c.translation().norm() > s.max_correction_m ||
+      Eigen::AngleAxisd(c.linear()).angle() > s.max_correction_rad) {
+    return GateReason::CorrectionTooLarge;
+  }
+  return GateReason::Accepted;
+}
+
+}  // namespace cube_scan_matcher

@@ -1,0 +1,111 @@
+#include "cube_scan_matcher/core/online_matcher.h"
+
+#include <sstream>
+#include <stdexcept>
+
+namespace cube_scan_matcher {
+
+void validate(const OnlineMatcherSettings& s) {
+  validate(s.registration);
+  validate(s.gate);
+  if (s.max_consecutive_rejections < 1) {
+    throw std::invalid_argument("max_consecutive_rejections must be >= 1, got " +
+                                std::to_string(s.max_consecutive_rejections));
+  }
+}
+
+OnlineMatcher::OnlineMatcher(const OnlineMatcherSettings& settings)
+    : settings_(settings), registration_(settings.registration) {}
+
+void OnlineMatcher::reset() {
+  registration_ = CubeRegistration(settings_.registration);
+  reference_points_ = PointArray{};
+  reference_pose_ = last_pose_ = Eigen::Isometry3d::Identity();
+  reference_odom_.reset();
+  last_stamp_.reset();
+  consecutive_rejections_ = 0;
+  settings_changed_ = false;
+}
+
+void OnlineMatcher::setSettings(const OnlineMatcherSettings& settings) {
+  validate(settings);
+  settings_ = settings;
+  settings_changed_ = true;
+}
+
+OnlineStep OnlineMatcher::process(const PointArray& points, double stamp,
+                                  const std::optional<Eigen::Isometry3d>& odom) {
+  OnlineStep step;
+  if (last_stamp_ && stamp < *last_stamp_) {
+    reset();
+    step.time_reset = true;
+  }
+  last_stamp_ = stamp;
+  if (settings_changed_) {
+    // New settings: a new cube edge or refine grid needs the reference grid rebuilt.
+    settings_changed_ = false;
+    const bool had = registration_.hasReference();
+    registration_.setSettings(settings_.registration);
+    if (had) {
+      try {
+        registration_.setReference(reference_points_);
+      } catch (const std::exception& e) {
+        // Keeps the grid built with the old settings; the next scan replaces it.
+        step.message = std::string("reference not rebuilt with the new settings: ") + e.what();
+      }
+    }
+  }
+
+  const bool first = !registration_.hasReference();
+  step.odometry_guess = odom && reference_odom_;
+  const Eigen::Isometry3d odom_increment = step.odometry_guess
+                                               ? Eigen::Isometry3d(reference_odom_->inverse() * *odom)
+                                               : Eigen::Isometry3d::Identity();
+  step.guess = isometryToPose(odom_increment);
+  step.increment = odom_increment;
+
+  if (first) {
+    step.reason = points.empty() ? GateReason::BadInput : GateReason::FirstScan;
+    step.pose = odom ? *odom : Eigen::Isometry3d::Identity();
+  } else if (points.empty()) {
+    step.reason = GateReason::BadInput;
+  } else {
+    step.registered = true;
+    step.result = registration_.align(points, step.guess);
+    step.reason = gate(step.result, step.guess, settings_.gate);
+    if (step.result.ok()) step.correction = correctionFromGuess(step.guess, step.result.pose);
+    step.accepted = step.reason == GateReason::Accepted;
+    if (step.accepted) step.increment = step.result.transform;
+  }
+  if (!first) step.pose = reference_pose_ * step.increment;
+
+  const bool rejected = !first && !step.accepted;
+  consecutive_rejections_ = rejected ? consecutive_rejections_ + 1 : 0;
+  step.consecutive_rejections = consecutive_rejections_;
+  step.rejection_alarm = consecutive_rejections_ >= settings_.max_consecutive_rejections;
+
+  // This scan becomes the reference if it has points and its grid can be built.
+  if (!points.empty()) {
+    try {
+      registration_.setReference(points);
+      reference_points_ = points;
+      reference_pose_ = step.pose;
+      reference_odom_ = odom;
+      step.reference_updated = true;
+    } catch (const std::exception& e) {
+      if (first) step.reason = GateReason::BadReference;
+      if (!step.message.empty()) step.message += "; ";
+      step.message += std::string("scan not used as reference: ") + e.what();
+    }
+  }
+  last_pose_ = step.pose;
+
+  std::ostringstream os;
+  os << toString(step.reason);
+  if (step.registered) os << " (" << step.result.message << ")";
+  if (!step.message.empty()) os << "; " << step.message;
+  step.message = os.str();
+  return step;
+}
+
+}  // namespace cube_scan_matcher

@@ -1,0 +1,164 @@
+#include "cube_scan_matcher/ros/params.h"
+
+#include <cmath>
+#include <sstream>
+
+#include "cube_scan_matcher/core/pose.h"
+
+namespace cube_scan_matcher {
+namespace {
+
+template <typename T>
+std::string str(T v) {
+  std::ostringstream os;
+  os << v;
+  return os.str();
+}
+
+/// Reads ~name (default `value`) and checks lo <= value <= hi.
+template <typename T>
+T get(const ros::NodeHandle& pnh, const std::string& name, T value, T lo, T hi,
+      const std::string& unit = "") {
+  if (pnh.hasParam(name) && !pnh.getParam(name, value)) {
+    throw ParamError("parameter ~" + name + " has the wrong type (expected a number)");
+  }
+  if (!(value >= lo && value <= hi)) {  // also false for NaN
+    throw ParamError("parameter ~" + name + " = " + str(value) + " is out of range [" + str(lo) +
+                     ", " + str(hi) + "]" + (unit.empty() ? "" : " " + unit));
+  }
+  return value;
+}
+
+std::string getString(const ros::NodeHandle& pnh, const std::string& name, std::string value) {
+  if (pnh.hasParam(name) && !pnh.getParam(name, value)) {
+    throw ParamError("parameter ~" + name + " must be a string");
+  }
+  if (value.empty()) throw ParamError("parameter ~" + name + " must not be empty");
+  return value;
+}
+
+bool getBool(const ros::NodeHandle& pnh, const std::string& name, bool value) {
+  if (pnh.hasParam(name) && !pnh.getParam(name, value)) {
+    throw ParamError("parameter ~" + name + " must be true or false");
+  }
+  return value;
+}
+
+/// Live parameters: the config's fields are the parameters of the same name.
+void configToSettings(const ScanMatcherConfig& c, OnlineMatcherSettings& m) {
+  RegistrationSettings& r = m.registration;
+  r.grid.cube_edge = c.cube_edge;
+  r.gnmm.vertices = c.vertices;
+  r.gnmm.max_iterations = c.iterations;
+  const double a = deg2rad(c.bounds_rotation);
+  r.gnmm.bounds << c.bounds_translation, c.bounds_translation, c.bounds_translation, a, a, a;
+  r.gnmm.seed = std::uint64_t(c.seed);
+  r.search.starts = c.starts;
+  r.search.threads = c.threads;
+  r.collapse_fraction = c.collapse_fraction;
+  r.refine.enabled = c.refine;
+  r.refine.edge_fraction = c.refine_edge_fraction;
+  r.refine.grids = c.refine_grids;
+  m.gate.min_overlap = c.min_overlap;
+  m.gate.min_j_gain = c.min_j_gain;
+  m.gate.max_correction_m = c.max_correction_translation;
+  m.gate.max_correction_rad = deg2rad(c.max_correction_rotation);
+  m.max_consecutive_rejections = c.max_consecutive_rejections;
+}
+
+}  // namespace
+
+ScanMatcherConfig toConfig(const NodeParams& p) {
+  ScanMatcherConfig c = ScanMatcherConfig::__getDefault__();
+  const RegistrationSettings& r = p.matcher.registration;
+  c.cube_edge = r.grid.cube_edge;
+  c.vertices = r.gnmm.vertices;
+  c.iterations = r.gnmm.max_iterations;
+  c.bounds_translation = r.gnmm.bounds[0];
+  c.bounds_rotation = rad2deg(r.gnmm.bounds[3]);
+  c.seed = int(r.gnmm.seed);
+  c.starts = r.search.starts;
+  c.threads = r.search.threads;
+  c.collapse_fraction = r.collapse_fraction;
+  c.refine = r.refine.enabled;
+  c.refine_edge_fraction = r.refine.edge_fraction;
+  c.refine_grids = r.refine.grids;
+  c.min_overlap = p.matcher.gate.min_overlap;
+  c.min_j_gain = p.matcher.gate.min_j_gain;
+  c.max_correction_translation = p.matcher.gate.max_correction_m;
+  c.max_correction_rotation = rad2deg(p.matcher.gate.max_correction_rad);
+  c.max_consecutive_rejections = p.matcher.max_consecutive_rejections;
+  return c;
+}
+
+NodeParams loadParams(const ros::NodeHandle& pnh) {
+  NodeParams p;
+  p.base_frame = getString(pnh, "base_frame", p.base_frame);
+  p.odom_frame = getString(pnh, "odom_frame", p.odom_frame);
+  p.map_frame = getString(pnh, "map_frame", p.map_frame);
+  if (p.map_frame == p.odom_frame || p.map_frame == p.base_frame) {
+    throw ParamError("parameter ~map_frame must differ from ~odom_frame and ~base_frame");
+  }
+  p.tf_timeout = get(pnh, "tf_timeout", p.tf_timeout, 0.0, 10.0, "s");
+  const std::string policy = getString(pnh, "missing_tf_policy", "identity");
+  if (policy != "identity" && policy != "skip") {
+    throw ParamError("parameter ~missing_tf_policy = '" + policy + "' must be identity or skip");
+  }
+  p.skip_without_tf = policy == "skip";
+  p.publish_tf = getBool(pnh, "publish_tf", p.publish_tf);
+  p.queue_size = get(pnh, "queue_size", p.queue_size, 1, 100);
+  p.path_max_length = get(pnh, "path_max_length", p.path_max_length, 1, 1000000);
+  p.filter.min_range = get(pnh, "min_range", p.filter.min_range, 0.0, 1e4, "m");
+  const double max_range = get(pnh, "max_range", 0.0, 0.0, 1e6, "m (0 = no limit)");
+  p.filter.max_range = max_range > 0.0 ? max_range : 1e9;
+  if (p.filter.max_range <= p.filter.min_range) {
+    throw ParamError("parameter ~max_range must exceed ~min_range (or be 0 = no limit)");
+  }
+  p.sigma_translation = get(pnh, "sigma_translation", p.sigma_translation, 1e-6, 100.0, "m");
+  p.sigma_rotation = get(pnh, "sigma_rotation", p.sigma_rotation, 1e-6, 180.0, "deg");
+  p.rejected_sigma_scale = get(pnh, "rejected_sigma_scale", p.rejected_sigma_scale, 1.0, 1e6);
+  p.min_rate = get(pnh, "min_rate", p.min_rate, 0.0, 1000.0, "Hz");
+  p.max_rate = get(pnh, "max_rate", p.max_rate, 0.0, 1e6, "Hz");
+  if (p.max_rate <= p.min_rate) throw ParamError("parameter ~max_rate must exceed ~min_rate");
+  p.max_latency = get(pnh, "max_latency", p.max_latency, 1e-3, 1000.0, "s");
+  const double megabytes = get(pnh, "max_grid_megabytes", 256.0, 1.0, 65536.0, "MB");
+  p.matcher.registration.grid.max_cubes = std::uint64_t(megabytes * 8.0 * 1024.0 * 1024.0);
+
+  // Live parameters: ranges as in cfg/ScanMatcher.cfg.
+  ScanMatcherConfig c = toConfig(p);
+  c.cube_edge = get(pnh, "cube_edge", c.cube_edge, 0.05, 5.0, "m");
+  c.vertices = get(pnh, "vertices", c.vertices, 7, 1000);
+  c.iterations = get(pnh, "iterations", c.iterations, 1, 100000);
+  c.bounds_translation = get(pnh, "bounds_translation", c.bounds_translation, 0.01, 20.0, "m");
+  c.bounds_rotation = get(pnh, "bounds_rotation", c.bounds_rotation, 0.1, 90.0, "deg");
+  c.starts = get(pnh, "starts", c.starts, 1, 64);
+  c.threads = get(pnh, "threads", c.threads, 1, 64);
+  c.collapse_fraction = get(pnh, "collapse_fraction", c.collapse_fraction, 0.0, 1.0);
+  c.refine = getBool(pnh, "refine", c.refine);
+  c.refine_edge_fraction = get(pnh, "refine_edge_fraction", c.refine_edge_fraction, 0.05, 0.95);
+  c.refine_grids = get(pnh, "refine_grids", c.refine_grids, 1, 8);
+  c.seed = get(pnh, "seed", c.seed, 0, 2147483647);
+  c.min_overlap = get(pnh, "min_overlap", c.min_overlap, 0.0, 1.0);
+  c.min_j_gain = get(pnh, "min_j_gain", c.min_j_gain, 0, 1000000);
+  c.max_correction_translation =
+      get(pnh, "max_correction_translation", c.max_correction_translation, 0.01, 100.0, "m");
+  c.max_correction_rotation =
+      get(pnh, "max_correction_rotation", c.max_correction_rotation, 0.1, 180.0, "deg");
+  c.max_consecutive_rejections =
+      get(pnh, "max_consecutive_rejections", c.max_consecutive_rejections, 1, 1000000);
+  applyConfig(c, p);
+  return p;
+}
+
+void applyConfig(const ScanMatcherConfig& config, NodeParams& params) {
+  OnlineMatcherSettings m = params.matcher;
+  configToSettings(config, m);
+  try {
+    validate(m);
+  } catch (const std::invalid_argument& e) {
+    throw ParamError(std::string("invalid parameters: ") + e.what());
+  }
+  params.matcher = m;
+}
+
+}  // namespace cube_scan_matcher

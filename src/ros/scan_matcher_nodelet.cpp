@@ -1,0 +1,349 @@
+#include "cube_scan_matcher/ros/scan_matcher_nodelet.h"
+
+#include <algorithm>
+#include <iomanip>
+#include <sstream>
+
+#include <geometry_msgs/PoseWithCovarianceStamped.h>
+#include <geometry_msgs/TransformStamped.h>
+#include <nav_msgs/Odometry.h>
+#include <pluginlib/class_list_macros.hpp>
+#include <tf2_eigen/tf2_eigen.h>
+
+#include "cube_scan_matcher/Status.h"
+#include "cube_scan_matcher/core/filters.h"
+#include "cube_scan_matcher/ros/cloud_conversion.h"
+
+namespace cube_scan_matcher {
+namespace {
+
+geometry_msgs::Pose toPoseMsg(const Eigen::Isometry3d& T) { return tf2::toMsg(T); }
+
+/// Diagonal covariance [x y z roll pitch yaw] from standard deviations [m] and [deg].
+boost::array<double, 36> covariance(double sigma_m, double sigma_deg) {
+  boost::array<double, 36> c{};
+  const double a = deg2rad(sigma_deg);
+  for (int i = 0; i < 3; ++i) c[std::size_t(i * 7)] = sigma_m * sigma_m;
+  for (int i = 3; i < 6; ++i) c[std::size_t(i * 7)] = a * a;
+  return c;
+}
+
+double percentile(std::deque<double> v, double q) {
+  if (v.empty()) return 0.0;
+  std::sort(v.begin(), v.end());
+  return v[std::min(v.size() - 1, std::size_t(q * double(v.size())))];
+}
+
+}  // namespace
+
+ScanMatcherNodelet::~ScanMatcherNodelet() = default;
+
+void ScanMatcherNodelet::onInit() {
+  ros::NodeHandle& nh = getNodeHandle();
+  ros::NodeHandle& pnh = getPrivateNodeHandle();
+  updater_ = std::make_unique<diagnostic_updater::Updater>(nh, pnh, getName());
+  updater_->setHardwareID("none");
+  updater_->add("registration", this, &ScanMatcherNodelet::diagnose);
+  diagnostics_timer_ = nh.createTimer(ros::Duration(1.0), [this](const ros::TimerEvent&) {
+    updater_->update();
+  });
+  try {
+    params_ = loadParams(pnh);
+  } catch (const std::exception& e) {
+    // Refuse to start, but never take the manager (and its other nodelets) down.
+    init_error_ = e.what();
+    NODELET_FATAL("%s. ScanMatcherNodelet is NOT running: fix the parameter and restart it.",
+                  e.what());
+    return;
+  }
+  matcher_ = std::make_unique<OnlineMatcher>(params_.matcher);
+
+  min_rate_ = params_.min_rate;
+  max_rate_ = params_.max_rate;
+  rate_status_ = std::make_unique<diagnostic_updater::FrequencyStatus>(
+      diagnostic_updater::FrequencyStatusParam(&min_rate_, &max_rate_, 0.1, 10), "input rate");
+  updater_->add(*rate_status_);
+
+  tf_buffer_ = std::make_unique<tf2_ros::Buffer>(ros::Duration(60.0));
+  tf_listener_ = std::make_unique<tf2_ros::TransformListener>(*tf_buffer_, nh);
+  if (params_.publish_tf) tf_broadcaster_ = std::make_unique<tf2_ros::TransformBroadcaster>();
+
+  pose_pub_ = pnh.advertise<geometry_msgs::PoseWithCovarianceStamped>("pose", 10);
+  odom_pub_ = pnh.advertise<nav_msgs::Odometry>("odometry", 10);
+  path_pub_ = pnh.advertise<nav_msgs::Path>("path", 1, true);
+  cloud_pub_ = pnh.advertise<sensor_msgs::PointCloud2>("registered_cloud", 2);
+  status_pub_ = pnh.advertise<Status>("status", 10);
+  reset_srv_ = pnh.advertiseService("reset", &ScanMatcherNodelet::resetService, this);
+
+  reconfigure_server_ =
+      std::make_unique<dynamic_reconfigure::Server<ScanMatcherConfig>>(reconfigure_mutex_, pnh);
+  reconfigure_server_->updateConfig(toConfig(params_));
+  reconfigure_server_->setCallback(
+      [this](ScanMatcherConfig& c, uint32_t level) { reconfigure(c, level); });
+
+  path_.header.frame_id = params_.map_frame;
+  initialised_ = true;
+  // Subscribe last: callbacks may start at once.
+  cloud_sub_ = nh.subscribe("cloud", std::uint32_t(params_.queue_size),
+                            &ScanMatcherNodelet::cloudCallback, this);
+  NODELET_INFO("ScanMatcherNodelet: registering %s in %s (odometry %s, poses in %s), E = %.2f m",
+               cloud_sub_.getTopic().c_str(), params_.base_frame.c_str(),
+               params_.odom_frame.c_str(), params_.map_frame.c_str(),
+               params_.matcher.registration.grid.cube_edge);
+}
+
+void ScanMatcherNodelet::reconfigure(ScanMatcherConfig& config, uint32_t /*level*/) {
+  std::lock_guard<std::mutex> lock(mutex_);
+  try {
+    applyConfig(config, params_);
+    matcher_->setSettings(params_.matcher);
+  } catch (const std::exception& e) {
+    NODELET_ERROR("dynamic_reconfigure request refused, settings unchanged: %s", e.what());
+    config = toConfig(params_);
+  }
+}
+
+bool ScanMatcherNodelet::resetService(std_srvs::Trigger::Request&, std_srvs::Trigger::Response& res) {
+  std::lock_guard<std::mutex> lock(mutex_);
+  resetState("reset requested through the ~reset service");
+  res.success = true;
+  res.message = "reference, pose chain, path and counters reset";
+  return true;
+}
+
+void ScanMatcherNodelet::resetState(const std::string& why) {
+  NODELET_WARN("%s: the next scan starts a new pose chain", why.c_str());
+  if (matcher_) matcher_->reset();
+  path_.poses.clear();
+  last_seq_.reset();
+  last_stamp_.reset();
+  dropped_ = rejected_ = tf_failures_ = processed_ = bad_input_ = consecutive_rejections_ = 0;
+  latencies_.clear();
+}
+
+std::optional<Eigen::Isometry3d> ScanMatcherNodelet::lookup(const std::string& target,
+                                                            const std::string& source,
+                                                            const ros::Time& stamp,
+                                                            std::string& error) {
+  try {
+    // A bounded wait at the exact stamp: never the "latest" transform.
+    const geometry_msgs::TransformStamped t =
+        tf_buffer_->lookupTransform(target, source, stamp, ros::Duration(params_.tf_timeout));
+    return tf2::transformToEigen(t);
+  } catch (const tf2::TransformException& e) {
+    if (!error.empty()) error += "; ";
+    error += e.what();
+    return std::nullopt;
+  }
+}
+
+void ScanMatcherNodelet::cloudCallback(const sensor_msgs::PointCloud2ConstPtr& msg) {
+  const double received = ros::WallTime::now().toSec();
+  if (!initialised_) return;
+  rate_status_->tick();
+  std::lock_guard<std::mutex> lock(mutex_);
+  try {
+    processCloud(*msg, received);
+  } catch (const std::exception& e) {
+    NODELET_ERROR_THROTTLE(5.0, "scan %u not processed: %s", msg->header.seq, e.what());
+  }
+}
+
+void ScanMatcherNodelet::processCloud(const sensor_msgs::PointCloud2& msg, double received) {
+  const ros::Time stamp = msg.header.stamp;
+  Status status;
+  status.header.stamp = stamp;
+  status.header.frame_id = params_.map_frame;
+  status.points_in = msg.width * msg.height;
+  auto publishStatus = [&](GateReason reason, const std::string& message) {
+    status.reason = std::uint8_t(reason);
+    status.reason_text = toString(reason);
+    status.accepted = reason == GateReason::Accepted;
+    status.message = message;
+    status.rejected_scans = rejected_;
+    status.tf_failures = tf_failures_;
+    status.dropped_scans = dropped_;
+    status.consecutive_rejections = consecutive_rejections_;
+    status.latency = ros::WallTime::now().toSec() - received;
+    last_latency_ = status.latency;
+    latencies_.push_back(status.latency);
+    if (latencies_.size() > 200) latencies_.pop_front();
+    status_pub_.publish(status);
+  };
+
+  if (stamp.isZero()) {
+    ++bad_input_;
+    NODELET_ERROR_THROTTLE(5.0, "cloud %u has a zero stamp; tf cannot be looked up at it",
+                           msg.header.seq);
+    publishStatus(GateReason::BadInput, "cloud has a zero stamp");
+    return;
+  }
+  // Time going backwards: a looping bag or a reset clock. One warning, then a fresh start.
+  if (last_stamp_ && stamp < *last_stamp_) {
+    std::ostringstream os;
+    os << std::fixed << std::setprecision(3) << "time went backwards from " << last_stamp_->toSec() << " s to " << stamp.toSec()
+       << " s (bag loop or clock reset)";
+    resetState(os.str());
+    tf_buffer_->clear();
+    status.time_reset = true;
+  }
+  if (last_seq_ && msg.header.seq > *last_seq_ + 1) dropped_ += msg.header.seq - *last_seq_ - 1;
+  last_seq_ = msg.header.seq;
+  last_stamp_ = stamp;
+
+  // The cloud in base_frame at its stamp, and the odometry pose there.
+  std::string tf_error;
+  std::optional<Eigen::Isometry3d> T_base_cloud;
+  if (msg.header.frame_id.empty()) {
+    ++bad_input_;
+    NODELET_ERROR_THROTTLE(5.0, "cloud %u has an empty frame_id", msg.header.seq);
+    publishStatus(GateReason::BadInput, "cloud has an empty frame_id");
+    return;
+  }
+  if (msg.header.frame_id == params_.base_frame) {
+    T_base_cloud = Eigen::Isometry3d::Identity();
+  } else {
+    T_base_cloud = lookup(params_.base_frame, msg.header.frame_id, stamp, tf_error);
+  }
+  const std::optional<Eigen::Isometry3d> odom =
+      lookup(params_.odom_frame, params_.base_frame, stamp, tf_error);
+  status.tf_failed = !T_base_cloud || !odom;
+  if (status.tf_failed) {
+    ++tf_failures_;
+    NODELET_WARN_THROTTLE(5.0, "tf missing for scan at %.3f s within %.2f s: %s", stamp.toSec(),
+                          params_.tf_timeout, tf_error.c_str());
+  }
+  if (!T_base_cloud || (!odom && params_.skip_without_tf)) {
+    publishStatus(GateReason::SkippedNoTf,
+                  (T_base_cloud ? "odometry tf missing, missing_tf_policy = skip: "
+                                : "cloud frame cannot be brought into base_frame: ") +
+                      tf_error);
+    return;
+  }
+
+  FilterStats fs;
+  PointArray points;
+  try {
+    points = filterPoints(fromCloud(msg, *T_base_cloud), params_.filter, &fs);
+  } catch (const CloudError& e) {
+    ++bad_input_;
+    NODELET_ERROR_THROTTLE(5.0, "cloud %u rejected: %s", msg.header.seq, e.what());
+    publishStatus(GateReason::BadInput, e.what());
+    return;
+  }
+  status.points_valid = std::uint32_t(points.size());
+  if (points.empty()) {
+    ++bad_input_;
+    std::ostringstream os;
+    os << "cloud has no usable point: " << fs.input << " points, " << fs.non_finite
+       << " NaN/inf, " << fs.out_of_range << " outside [min_range, max_range]";
+    NODELET_WARN_THROTTLE(5.0, "%s", os.str().c_str());
+    publishStatus(GateReason::BadInput, os.str());
+    return;
+  }
+
+  // Register, gate and chain (core).
+  const OnlineStep step = matcher_->process(points, stamp.toSec(), odom);
+  ++processed_;
+  const RegistrationResult& r = step.result;
+  status.J = r.J;
+  status.J_guess = r.J_guess;
+  status.reference_cubes = std::int32_t(r.reference_cubes);
+  status.overlap = r.overlap();
+  status.points_used = std::uint32_t(r.points_used);
+  status.evaluations = r.evaluations;
+  status.iterations = r.iterations;
+  status.restarts = r.restarts;
+  status.registration_time = r.time_s;
+  for (int k = 0; k < 6; ++k) {
+    status.guess[std::size_t(k)] = step.guess[k];
+    status.correction[std::size_t(k)] = step.correction[k];
+  }
+  status.odometry_guess = step.odometry_guess;
+  status.reference_updated = step.reference_updated;
+  status.time_reset = status.time_reset || step.time_reset;
+  const bool rejected = step.reason != GateReason::Accepted && step.reason != GateReason::FirstScan;
+  if (rejected) ++rejected_;
+  consecutive_rejections_ = std::uint32_t(step.consecutive_rejections);
+  if (step.rejection_alarm) {
+    NODELET_ERROR_THROTTLE(5.0, "%d scans in a row rejected (last: %s): poses follow odometry only",
+                           step.consecutive_rejections, step.message.c_str());
+  } else if (rejected) {
+    NODELET_WARN_THROTTLE(2.0, "scan at %.3f s rejected: %s", stamp.toSec(), step.message.c_str());
+  }
+
+  // Outputs.
+  const bool registered_pose = step.reason == GateReason::Accepted ||
+                               step.reason == GateReason::FirstScan;
+  const double scale = registered_pose ? 1.0 : params_.rejected_sigma_scale;
+  std_msgs::Header header;
+  header.stamp = stamp;
+  header.frame_id = params_.map_frame;
+
+  geometry_msgs::PoseWithCovarianceStamped pose;
+  pose.header = header;
+  pose.pose.pose = toPoseMsg(step.pose);
+  pose.pose.covariance =
+      covariance(params_.sigma_translation * scale, params_.sigma_rotation * scale);
+  pose_pub_.publish(pose);
+
+  nav_msgs::Odometry odometry;
+  odometry.header = header;
+  odometry.child_frame_id = params_.base_frame;
+  odometry.pose = pose.pose;
+  odometry.twist.covariance[0] = -1.0;  // no twist estimate
+  odom_pub_.publish(odometry);
+
+  geometry_msgs::PoseStamped path_pose;
+  path_pose.header = header;
+  path_pose.pose = pose.pose.pose;
+  path_.header.stamp = stamp;
+  path_.poses.push_back(path_pose);
+  if (path_.poses.size() > std::size_t(params_.path_max_length)) {
+    path_.poses.erase(path_.poses.begin(),
+                      path_.poses.end() - std::ptrdiff_t(params_.path_max_length));
+  }
+  path_pub_.publish(path_);
+
+  if (cloud_pub_.getNumSubscribers() > 0) cloud_pub_.publish(toCloud(points, step.pose, header));
+
+  if (tf_broadcaster_ && odom) {
+    // REP-105: map -> odom such that map -> odom -> base_link equals the registered pose.
+    geometry_msgs::TransformStamped t = tf2::eigenToTransform(step.pose * odom->inverse());
+    t.header = header;
+    t.child_frame_id = params_.odom_frame;
+    tf_broadcaster_->sendTransform(t);
+  }
+  publishStatus(step.reason, step.message);
+}
+
+void ScanMatcherNodelet::diagnose(diagnostic_updater::DiagnosticStatusWrapper& stat) {
+  using diagnostic_msgs::DiagnosticStatus;
+  if (!init_error_.empty()) {
+    stat.summary(DiagnosticStatus::ERROR, "not running: " + init_error_);
+    return;
+  }
+  std::lock_guard<std::mutex> lock(mutex_);
+  const double median = percentile(latencies_, 0.5), p95 = percentile(latencies_, 0.95);
+  stat.add("scans processed", processed_);
+  stat.add("scans rejected", rejected_);
+  stat.add("consecutive rejections", consecutive_rejections_);
+  stat.add("tf failures", tf_failures_);
+  stat.add("bad input scans", bad_input_);
+  stat.add("dropped scans", dropped_);
+  stat.add("latency median [s]", median);
+  stat.add("latency p95 [s]", p95);
+  if (matcher_ && consecutive_rejections_ >= std::uint32_t(params_.matcher.max_consecutive_rejections)) {
+    stat.summary(DiagnosticStatus::ERROR, "consecutive rejections: poses follow odometry only");
+  } else if (median > params_.max_latency) {
+    stat.summary(DiagnosticStatus::WARN, "latency above max_latency");
+  } else if (rejected_ > 0 || tf_failures_ > 0 || dropped_ > 0 || bad_input_ > 0) {
+    stat.summary(DiagnosticStatus::WARN, "some scans rejected, dropped or without tf");
+  } else {
+    stat.summary(DiagnosticStatus::OK, processed_ ? "registering" : "waiting for scans");
+  }
+}
+
+}  // namespace cube_scan_matcher
+
+PLUGINLIB_EXPORT_CLASS(cube_scan_matcher::ScanMatcherNodelet, nodelet::Nodelet)
