@@ -1,0 +1,67 @@
+// Simulated robot motion and DGPS/IMU odometry for the demo, the simulator node and tests:
+// forward steps between sweeps like the paper's pairs, and odometry with known errors.
+#pragma once
+
+#include <cstdint>
+#include <random>
+#include <string>
+
+#include <Eigen/Geometry>
+
+#include "cube_scan_matcher/sim/scene.h"
+
+namespace cube_scan_matcher::sim {
+
+struct MotionSettings {
+  double step_min = 1.0, step_max = 5.0;  ///< [m] travel between sweeps.
+  double yaw_change_max_deg = 45.0;       ///< [deg] largest heading change between sweeps.
+  double heading_max_deg = 22.5;          ///< [deg] heading kept within this of the street axis.
+  double lateral_limit = 2.0;             ///< [m] beyond |y| of this the robot turns back.
+  double x_min = -10.0, x_max = 130.0;    ///< [m] U-turn (4 x 45 deg, 1 m steps) beyond these.
+  double height = 1.0;                    ///< [m] base_link above the ground.
+  double tilt_max_deg = 1.0;              ///< [deg] random roll and pitch.
+};
+
+/// Truth of base_link in the world (x forward along the street, z up), one pose per sweep.
+class RobotMotion {
+ public:
+  RobotMotion(const Scene& scene, const MotionSettings& settings, std::uint64_t seed);
+  const Eigen::Isometry3d& pose() const { return pose_; }
+  /// Moves to the pose of the next sweep.
+  void advance();
+
+ private:
+  void place();
+  const Scene& scene_;
+  MotionSettings s_;
+  std::mt19937_64 rng_;
+  double x_ = 0.0, y_ = 0.0, heading_ = 0.0;
+  int dir_ = 1, turning_ = 0;
+  Eigen::Isometry3d pose_ = Eigen::Isometry3d::Identity();
+};
+
+enum class OdometryError {
+  None,   ///< odometry = truth
+  Small,  ///< each increment off by uniform +-0.25 m, +-2 deg per parameter (paper "small")
+  Big,    ///< each increment off by uniform +-1 m, +-8 deg per parameter (paper "big")
+  Drift,  ///< DGPS-like: a slowly wandering offset (random walk, 5 cm and 0.3 deg per sweep)
+};
+/// "none", "small", "big", "drift"; throws std::invalid_argument otherwise.
+OdometryError odometryErrorFromString(const std::string& name);
+
+/// T_odom_base per sweep. The first sweep's odometry equals the truth (map = odom = world).
+class OdometrySimulator {
+ public:
+  OdometrySimulator(OdometryError mode, std::uint64_t seed);
+  Eigen::Isometry3d next(const Eigen::Isometry3d& truth);
+
+ private:
+  OdometryError mode_;
+  std::mt19937_64 rng_;
+  bool first_ = true;
+  Eigen::Isometry3d last_truth_ = Eigen::Isometry3d::Identity();
+  Eigen::Isometry3d last_odom_ = Eigen::Isometry3d::Identity();
+  Eigen::Isometry3d bias_ = Eigen::Isometry3d::Identity();
+};
+
+}  // namespace cube_scan_matcher::sim
