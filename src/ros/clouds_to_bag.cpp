@@ -1,0 +1,167 @@
+// clouds_to_bag OUTPUT.bag (--dataset DIR | CLOUD... [--poses FILE]) [options]
+// Writes real scans into a bag that launch/bag_replay.launch can replay: one PointCloud2 per
+// cloud (in --frame, default base_link) at --rate, plus tf odom -> base_link at each cloud's
+// stamp from the poses (a poses file, or the chain of a dataset folder's pairs.txt).
+#include <fstream>
+#include <iostream>
+#include <map>
+#include <random>
+#include <sstream>
+
+#include <rosbag/bag.h>
+#include <tf2_eigen/tf2_eigen.h>
+#include <tf2_msgs/TFMessage.h>
+
+#include "cloud_io.h"
+#include "cube_scan_matcher/core/pose.h"
+#include "cube_scan_matcher/ros/cloud_conversion.h"
+#include "dataset.h"
+#include "settings_cli.h"
+
+using namespace cube_scan_matcher;
+
+namespace {
+
+const char* kUsage =
+    "usage: clouds_to_bag OUTPUT.bag (--dataset DIR | CLOUD... [--poses FILE]) [options]\n"
+    "  --dataset DIR        a folder in the format of shared/data/README.md: its clouds in\n"
+    "                       chain order, poses from chaining pairs.txt (the first target = origin)\n"
+    "  --poses FILE         one line per CLOUD: tx ty tz qx qy qz qw = T_odom_base [m]; without\n"
+    "                       poses (and without --dataset) no tf is written\n"
+    "  --rate HZ            clouds per second (default 1)\n"
+    "  --start S            stamp of the first cloud [s] (default 1000)\n"
+    "  --topic NAME         cloud topic (default assembled_cloud)\n"
+    "  --frame NAME         cloud and base frame (default base_link)\n"
+    "  --odom-frame NAME    odometry frame (default odom)\n"
+    "  --odometry-error T A add uniform errors of +-T [m] and +-A [deg] per parameter to each\n"
+    "                       pose increment, so the matcher has to correct them (default 0 0)\n"
+    "  --seed N             seed of those errors (default 1)\n";
+
+Eigen::Isometry3d readPose(std::istringstream& in, const std::string& where) {
+  double t[3], q[4];
+  if (!(in >> t[0] >> t[1] >> t[2] >> q[0] >> q[1] >> q[2] >> q[3])) {
+    throw std::runtime_error(where + ": expected tx ty tz qx qy qz qw");
+  }
+  Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
+  T.linear() = Eigen::Quaterniond(q[3], q[0], q[1], q[2]).normalized().toRotationMatrix();
+  T.translation() = Eigen::Vector3d(t[0], t[1], t[2]);
+  return T;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  std::vector<std::string> args(argv + 1, argv + argc);
+  if (args.empty() || args[0] == "-h" || args[0] == "--help") {
+    std::cout << kUsage;
+    return args.empty() ? 1 : 0;
+  }
+  try {
+    const std::string output = args[0];
+    std::vector<std::string> clouds;
+    std::vector<Eigen::Isometry3d> poses;
+    std::string dataset, poses_file, topic = "assembled_cloud", frame = "base_link", odom_frame = "odom";
+    double rate = 1.0, start = 1000.0, err_t = 0.0, err_a = 0.0;
+    std::uint64_t seed = 1;
+    for (std::size_t i = 1; i < args.size(); ++i) {
+      const std::string& a = args[i];
+      auto value = [&]() -> std::string {
+        if (i + 1 >= args.size()) throw std::invalid_argument(a + ": missing value");
+        return args[++i];
+      };
+      if (a == "--dataset") dataset = value();
+      else if (a == "--poses") poses_file = value();
+      else if (a == "--rate") rate = tools::parseNumber(a, value());
+      else if (a == "--start") start = tools::parseNumber(a, value());
+      else if (a == "--topic") topic = value();
+      else if (a == "--frame") frame = value();
+      else if (a == "--odom-frame") odom_frame = value();
+      else if (a == "--seed") seed = std::uint64_t(tools::parseNumber(a, value()));
+      else if (a == "--odometry-error") {
+        err_t = tools::parseNumber(a, value());
+        err_a = tools::parseNumber(a, value());
+      } else if (a.rfind("--", 0) == 0) throw std::invalid_argument("unknown option " + a);
+      else clouds.push_back(a);
+    }
+    if (!(rate > 0.0)) throw std::invalid_argument("--rate must be > 0");
+    if (!(start > 0.0)) throw std::invalid_argument("--start must be > 0 (a zero stamp means no time)");
+    if (!dataset.empty()) {
+      if (!clouds.empty() || !poses_file.empty())
+        throw std::invalid_argument("--dataset replaces CLOUD... and --poses");
+      // Chain the pairs: the first pair's target is the origin; a source's pose is its
+      // target's pose times T_target_source.
+      const auto pairs = tools::readPairs(dataset);
+      std::map<std::string, Eigen::Isometry3d> pose_of;
+      clouds.push_back(pairs.front().target);
+      pose_of[pairs.front().target] = Eigen::Isometry3d::Identity();
+      for (bool grew = true; grew;) {
+        grew = false;
+        for (const auto& p : pairs) {
+          if (pose_of.count(p.target) && !pose_of.count(p.source)) {
+            pose_of[p.source] = pose_of[p.target] * p.T_target_source;
+            clouds.push_back(p.source);
+            grew = true;
+          }
+        }
+      }
+      for (const auto& c : clouds) poses.push_back(pose_of[c]);
+    } else if (!poses_file.empty()) {
+      std::ifstream in(poses_file);
+      if (!in) throw std::runtime_error("cannot open poses file " + poses_file);
+      std::string line;
+      for (int n = 1; std::getline(in, line); ++n) {
+        if (line.empty() || line[0] == '#') continue;
+        std::istringstream ls(line);
+        poses.push_back(readPose(ls, poses_file + ":" + std::to_string(n)));
+      }
+      if (poses.size() != clouds.size()) {
+        throw std::runtime_error(poses_file + " has " + std::to_string(poses.size()) +
+                                 " poses for " + std::to_string(clouds.size()) + " clouds");
+      }
+    }
+    if (clouds.empty()) throw std::invalid_argument("no cloud given");
+
+    // Odometry errors on each increment (the first pose stays exact).
+    if (!poses.empty() && (err_t > 0.0 || err_a > 0.0)) {
+      std::mt19937_64 rng(seed);
+      std::uniform_real_distribution<double> u(-1.0, 1.0);
+      std::vector<Eigen::Isometry3d> noisy{poses[0]};
+      for (std::size_t k = 1; k < poses.size(); ++k) {
+        Eigen::Isometry3d e = Eigen::Isometry3d::Identity();
+        e.translation() = err_t * Eigen::Vector3d(u(rng), u(rng), u(rng));
+        e.linear() = rotationFromRpy(deg2rad(err_a * u(rng)), deg2rad(err_a * u(rng)),
+                                     deg2rad(err_a * u(rng)));
+        noisy.push_back(noisy.back() * (poses[k - 1].inverse() * poses[k]) * e);
+      }
+      poses = noisy;
+    }
+
+    rosbag::Bag bag(output, rosbag::bagmode::Write);
+    for (std::size_t k = 0; k < clouds.size(); ++k) {
+      const ros::Time stamp(start + double(k) / rate);
+      const PointArray pts = tools::toPointArray(*tools::loadCloud(clouds[k]));
+      std_msgs::Header header;
+      header.stamp = stamp;
+      header.frame_id = frame;
+      header.seq = std::uint32_t(k);
+      if (!poses.empty()) {
+        geometry_msgs::TransformStamped t = tf2::eigenToTransform(poses[k]);
+        t.header.stamp = stamp;
+        t.header.frame_id = odom_frame;
+        t.child_frame_id = frame;
+        tf2_msgs::TFMessage tf;
+        tf.transforms.push_back(t);
+        bag.write("/tf", stamp - ros::Duration(0.001), tf);  // tf just before its cloud
+      }
+      bag.write("/" + topic, stamp, toCloud(pts, Eigen::Isometry3d::Identity(), header));
+      std::cout << clouds[k] << ": " << pts.size() << " points at " << stamp.toSec() << " s\n";
+    }
+    bag.close();
+    std::cout << "wrote " << clouds.size() << " clouds" << (poses.empty() ? "" : " and tf") << " to "
+              << output << "\n";
+  } catch (const std::exception& e) {
+    std::cerr << "clouds_to_bag: " << e.what() << "\n";
+    return 1;
+  }
+  return 0;
+}
