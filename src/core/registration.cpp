@@ -29,6 +29,10 @@ void validate(const RegistrationSettings& s) {
                                   std::to_string(s.refine.edge_fraction));
     }
     validate(s.refine.compass);
+    if (s.refine.candidates < 1 || s.refine.candidates > 64) {
+      throw std::invalid_argument("refine candidates must be in [1, 64], got " +
+                                  std::to_string(s.refine.candidates));
+    }
     if (s.refine.grids < 1 || s.refine.grids > 8) {
       throw std::invalid_argument("refine grids must be in [1, 8], got " +
                                   std::to_string(s.refine.grids));
@@ -42,6 +46,13 @@ void validate(const RegistrationSettings& s) {
     throw std::invalid_argument("search threads must be in [1, 64], got " +
                                 std::to_string(s.search.threads));
   }
+  if (s.search.consensus < 0 || s.search.consensus > 64) {
+    throw std::invalid_argument("search consensus must be in [0, 64], got " +
+                                std::to_string(s.search.consensus));
+  }
+  if (!(s.search.consensus_translation > 0.0 && s.search.consensus_rotation > 0.0)) {
+    throw std::invalid_argument("search consensus tolerances must be > 0");
+  }
   if (s.search.polish_runs < 0 || s.search.polish_runs > 10) {
     throw std::invalid_argument("search polish_runs must be in [0, 10], got " +
                                 std::to_string(s.search.polish_runs));
@@ -49,6 +60,10 @@ void validate(const RegistrationSettings& s) {
   if (s.search.polish_iterations < 1 || s.search.polish_iterations > 1000000) {
     throw std::invalid_argument("search polish_iterations must be in [1, 1000000], got " +
                                 std::to_string(s.search.polish_iterations));
+  }
+  if (s.refine.enabled && !(s.refine.collapse_fraction >= 0.0 && s.refine.collapse_fraction <= 1.0)) {
+    throw std::invalid_argument("refine collapse_fraction must be in [0, 1], got " +
+                                std::to_string(s.refine.collapse_fraction));
   }
   if (!(s.collapse_fraction >= 0.0 && s.collapse_fraction <= 1.0)) {
     throw std::invalid_argument("collapse_fraction must be in [0, 1], got " +
@@ -92,10 +107,10 @@ void CubeRegistration::setReference(const PointArray& reference) {
   has_reference_ = true;
 }
 
-const PointArray& CubeRegistration::prepareScan(const PointArray& scan,
-                                               PointArray& storage) const {
-  if (settings_.collapse_fraction <= 0.0) return scan;
-  storage = collapseToVoxels(scan, settings_.collapse_fraction * grid_.edge());
+const PointArray& CubeRegistration::prepareScan(const PointArray& scan, PointArray& storage,
+                                               double fraction) const {
+  if (fraction <= 0.0) return scan;
+  storage = collapseToVoxels(scan, fraction * grid_.edge());
   return storage;
 }
 
@@ -103,33 +118,52 @@ int CubeRegistration::score(const PointArray& scan, const Pose6& pose) const {
   if (!has_reference_) throw std::logic_error("CubeRegistration::score before setReference");
   if (scan.empty()) return 0;
   PointArray storage;
-  CoincidenceObjective objective(grid_, prepareScan(scan, storage));
+  CoincidenceObjective objective(grid_, prepareScan(scan, storage, settings_.collapse_fraction));
   return objective(pose);
 }
 
 GnmmResult CubeRegistration::coarseSearch(const PointArray& points, const Pose6& guess,
-                                          CoincidenceObjective& objective) const {
+                                          CoincidenceObjective& objective,
+                                          std::vector<Vector6d>* candidates) const {
   const SearchSettings& ss = settings_.search;
-  // Independent starts (seeds seed + k) spread over threads: start k runs on thread
-  // k % threads, each thread with its own objective (its own working copy of V).
-  std::vector<GnmmResult> runs(std::size_t(ss.starts));
-  auto run_starts = [&](int thread, CoincidenceObjective& f) {
-    for (int k = thread; k < ss.starts; k += ss.threads) {
-      GnmmSettings gs = settings_.gnmm;
-      gs.seed += std::uint64_t(k);
-      runs[std::size_t(k)] =
-          Gnmm(gs).maximize([&f](const Vector6d& p) { return double(f(p)); }, guess);
-    }
-  };
+  // Independent starts (seeds seed + k) in rounds of `threads` starts, one per thread, each
+  // thread with its own objective (its own working copy of V). After each round, stop once
+  // `consensus` finished starts agree with the best one (the basin is found).
   const int threads = std::min(ss.threads, ss.starts);
   std::vector<std::unique_ptr<CoincidenceObjective>> objectives;
-  std::vector<std::thread> pool;
   for (int t = 1; t < threads; ++t) {
     objectives.push_back(std::make_unique<CoincidenceObjective>(grid_, points));
-    pool.emplace_back(run_starts, t, std::ref(*objectives.back()));
   }
-  run_starts(0, objective);
-  for (std::thread& t : pool) t.join();
+  std::vector<GnmmResult> runs;
+  runs.reserve(std::size_t(ss.starts));
+  auto run = [&](int k, CoincidenceObjective& f, GnmmResult& out) {
+    GnmmSettings gs = settings_.gnmm;
+    gs.seed += std::uint64_t(k);
+    out = Gnmm(gs).maximize([&f](const Vector6d& p) { return double(f(p)); }, guess);
+  };
+  while (int(runs.size()) < ss.starts) {
+    const int first = int(runs.size()), count = std::min(threads, ss.starts - first);
+    runs.resize(std::size_t(first + count));
+    std::vector<std::thread> pool;
+    for (int t = 1; t < count; ++t) {
+      pool.emplace_back(run, first + t, std::ref(*objectives[std::size_t(t - 1)]),
+                        std::ref(runs[std::size_t(first + t)]));
+    }
+    run(first, objective, runs[std::size_t(first)]);
+    for (std::thread& t : pool) t.join();
+    if (ss.consensus > 0) {
+      const GnmmResult& top = *std::max_element(
+          runs.begin(), runs.end(),
+          [](const GnmmResult& a, const GnmmResult& b) { return a.best_value < b.best_value; });
+      int agree = 0;
+      for (const GnmmResult& r : runs) {
+        const Vector6d d = r.best - top.best;
+        agree += d.head<3>().norm() <= ss.consensus_translation &&
+                 d.tail<3>().cwiseAbs().maxCoeff() <= ss.consensus_rotation;
+      }
+      if (agree >= ss.consensus) break;
+    }
+  }
 
   int evaluations = 0, iterations = 0, restarts = 0;
   std::size_t winner = 0;
@@ -138,6 +172,24 @@ GnmmResult CubeRegistration::coarseSearch(const PointArray& points, const Pose6&
     iterations += runs[k].iterations;
     restarts += runs[k].restarts;
     if (runs[k].best_value > runs[winner].best_value) winner = k;
+  }
+  // Distinct start results by decreasing J: candidates for the refine stage.
+  if (candidates) {
+    std::vector<std::size_t> order(runs.size());
+    for (std::size_t k = 0; k < order.size(); ++k) order[k] = k;
+    std::stable_sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) {
+      return runs[a].best_value > runs[b].best_value;
+    });
+    candidates->clear();
+    for (std::size_t k : order) {
+      bool distinct = true;
+      for (const Vector6d& c : *candidates) {
+        const Vector6d d = runs[k].best - c;
+        distinct = distinct && !(d.head<3>().norm() <= ss.consensus_translation &&
+                                 d.tail<3>().cwiseAbs().maxCoeff() <= ss.consensus_rotation);
+      }
+      if (distinct) candidates->push_back(runs[k].best);
+    }
   }
   GnmmResult best = std::move(runs[winner]);
   best.initial_value = runs[0].initial_value;
@@ -181,11 +233,12 @@ RegistrationResult CubeRegistration::align(const PointArray& scan, const Pose6& 
   if (scan.empty()) return finish(RegistrationStatus::EmptyScan, "scan has no valid point");
 
   PointArray storage;
-  const PointArray* points = &prepareScan(scan, storage);
+  const PointArray* points = &prepareScan(scan, storage, settings_.collapse_fraction);
   res.points_used = points->size();
 
   CoincidenceObjective objective(grid_, *points);
-  const GnmmResult g = coarseSearch(*points, guess, objective);
+  std::vector<Vector6d> candidates;
+  const GnmmResult g = coarseSearch(*points, guess, objective, &candidates);
   res.pose = g.best;
   res.J = res.J_coarse = int(g.best_value);
   res.J_guess = int(g.initial_value);
@@ -195,21 +248,35 @@ RegistrationResult CubeRegistration::align(const PointArray& scan, const Pose6& 
   res.stop = g.stop;
 
   // Refine stage (not in the paper): compass search on the fine grids from the coarse
-  // result, maximising the sum of their J. It evaluates the same (collapsed) points; the
-  // default collapse voxel, E/4, is half a fine cube.
+  // result, maximising the sum of their J, on the scan collapsed at its own (finer) voxel; the
+  // default, E/4, is half a fine cube.
   if (settings_.refine.enabled && res.J > 0 && !fine_grids_.empty()) {
+    PointArray fine_storage;
+    const PointArray& fine_points =
+        settings_.refine.collapse_fraction == settings_.collapse_fraction
+            ? *points
+            : prepareScan(scan, fine_storage, settings_.refine.collapse_fraction);
     std::vector<CoincidenceObjective> fine;
     fine.reserve(fine_grids_.size());
-    for (const CubeGrid& grid : fine_grids_) fine.emplace_back(grid, *points);
-    const CompassResult c = compassMaximize(
-        [&fine](const Vector6d& p) {
-          int sum = 0;
-          for (CoincidenceObjective& j : fine) sum += j(p);
-          return double(sum);
-        },
-        res.pose, settings_.refine.compass);
-    res.pose = c.best;
-    res.evaluations += c.evaluations;
+    for (const CubeGrid& grid : fine_grids_) fine.emplace_back(grid, fine_points);
+    auto fine_j = [&fine](const Vector6d& p) {
+      int sum = 0;
+      for (CoincidenceObjective& j : fine) sum += j(p);
+      return double(sum);
+    };
+    // Refine the best `candidates` distinct coarse results (the winner first) and keep the
+    // highest fine J: the finer cubes settle near-ties of the coarse J.
+    candidates.resize(std::min(candidates.size(), std::size_t(settings_.refine.candidates)));
+    if (candidates.empty()) candidates.push_back(res.pose);
+    double best_fine = -1.0;
+    for (const Vector6d& start : candidates) {
+      const CompassResult c = compassMaximize(fine_j, start, settings_.refine.compass);
+      res.evaluations += c.evaluations;
+      if (c.best_value > best_fine) {
+        best_fine = c.best_value;
+        res.pose = c.best;
+      }
+    }
     res.J = objective(res.pose);
   }
   for (int k = 3; k < 6; ++k) res.pose[k] = wrapAngle(res.pose[k]);

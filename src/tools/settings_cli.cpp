@@ -29,6 +29,8 @@ std::string algorithmOptionsHelp() {
          "  --starts K            independent GNMM searches from the guess, best J wins\n"
          "                        (default " + std::to_string(d.search.starts) + "; paper 1)\n"
          "  --threads T           threads for the starts (default " + std::to_string(d.search.threads) + ")\n"
+         "  --consensus K         stop the starts once K agree on the best pose, 0 = run all\n"
+         "                        (default " + std::to_string(d.search.consensus) + ")\n"
          "  --polish-runs K       GNMM runs around the best pose, bounds halved each run\n"
          "                        (default " + std::to_string(d.search.polish_runs) + "; paper 0)\n"
          "  --polish-iterations N iterations of each polish run (default " + std::to_string(d.search.polish_iterations) + ")\n"
@@ -36,6 +38,10 @@ std::string algorithmOptionsHelp() {
          "                        0 = all points as in the paper (default " + num(d.collapse_fraction) + ")\n"
          "  --refine F            compass-search stage on cubes of F*E from the coarse result,\n"
          "                        0 = off as in the paper (default " + num(d.refine.enabled ? d.refine.edge_fraction : 0.0) + ")\n"
+         "  --refine-candidates K refine the K best distinct coarse results, keep the best\n"
+         "                        (default " + std::to_string(d.refine.candidates) + ")\n"
+         "  --refine-collapse F   the refine stage evaluates one point per voxel of F*E\n"
+         "                        (default " + num(d.refine.collapse_fraction) + ")\n"
          "  --refine-grids K      refine on the sum of J over K fine grids shifted by 1/K cube\n"
          "                        (anti-aliasing; default " + std::to_string(d.refine.grids) + ")\n"
          "  --refine-levels N     compass-search step halvings in the refine stage (default " + std::to_string(d.refine.compass.levels) + ")\n"
@@ -83,6 +89,10 @@ bool parseAlgorithmOption(const std::vector<std::string>& args, std::size_t& i,
     s.refine.enabled = value(1) > 0.0;
     if (s.refine.enabled) s.refine.edge_fraction = value(1);
     used = 2;
+  } else if (a == "--refine-candidates") {
+    s.refine.candidates = int(value(1)), used = 2;
+  } else if (a == "--refine-collapse") {
+    s.refine.collapse_fraction = value(1), used = 2;
   } else if (a == "--refine-grids") {
     s.refine.grids = int(value(1)), used = 2;
   } else if (a == "--refine-levels") {
@@ -95,6 +105,8 @@ bool parseAlgorithmOption(const std::vector<std::string>& args, std::size_t& i,
     s.search.starts = int(value(1)), used = 2;
   } else if (a == "--threads") {
     s.search.threads = int(value(1)), used = 2;
+  } else if (a == "--consensus") {
+    s.search.consensus = int(value(1)), used = 2;
   } else if (a == "--polish-runs") {
     s.search.polish_runs = int(value(1)), used = 2;
   } else if (a == "--polish-iterations") {

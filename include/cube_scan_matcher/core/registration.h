@@ -25,6 +25,12 @@ struct RefineSettings {
   /// Fine grids with origins shifted by k/grids of a fine cube, k = 0..grids-1; the refine
   /// objective is the sum of their J (anti-aliasing). In [1, 8].
   int grids = 1;
+  /// Distinct coarse results (of the independent starts, by decreasing J) refined; the highest
+  /// fine J wins. In [1, 64].
+  int candidates = 1;
+  /// The refine stage evaluates the scan collapsed to one point per voxel of this * E (the
+  /// coarse stage uses RegistrationSettings::collapse_fraction). 0 = all points. In [0, 1].
+  double collapse_fraction = 0.25;
   /// Compass search on the fine objective: first steps 0.125 m / 1 deg, halved 5 times.
   CompassSettings compass;
 };
@@ -33,10 +39,16 @@ struct RefineSettings {
 /// from the initial estimate (starts = 1, polish_runs = 0).
 struct SearchSettings {
   /// Independent GNMM searches from the initial estimate, seeds gnmm.seed + k; the highest J
-  /// wins (ties: lowest k). In [1, 64].
+  /// wins (ties: lowest k). In [1, 64]. Fewer run when `consensus` is reached early.
   int starts = 1;
-  /// Threads the starts run on; each owns a working copy of V. In [1, 64].
+  /// Threads the starts run on, in rounds of `threads` starts; each thread owns a working
+  /// copy of V. In [1, 64].
   int threads = 1;
+  /// Stop after a round once this many finished starts agree with the best one (within the
+  /// tolerances below); 0 = always run every start. In [0, 64].
+  int consensus = 0;
+  double consensus_translation = 0.1;             ///< [m], > 0.
+  double consensus_rotation = 0.017453292519943295;  ///< [rad] per angle, > 0 (1 deg).
   /// Follow-up GNMM runs around the best pose so far, the restart bounds halved at each run
   /// (a run keeps its result only if J improves). In [0, 10].
   int polish_runs = 0;
@@ -118,10 +130,12 @@ class CubeRegistration {
   /// The coarse stage on `objective` (the grid of edge E): settings_.search.starts GNMM runs
   /// from `guess`, then the polish runs. Counts of all runs are summed into the result.
   GnmmResult coarseSearch(const PointArray& points, const Pose6& guess,
-                          CoincidenceObjective& objective) const;
+                          CoincidenceObjective& objective,
+                          std::vector<Vector6d>* candidates = nullptr) const;
 
   /// The points the objective evaluates: `scan` itself, or its collapsed copy in `storage`.
-  const PointArray& prepareScan(const PointArray& scan, PointArray& storage) const;
+  const PointArray& prepareScan(const PointArray& scan, PointArray& storage,
+                                double fraction) const;
 
   RegistrationSettings settings_;
   CubeGrid grid_;

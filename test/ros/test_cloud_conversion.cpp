@@ -1,0 +1,83 @@
+// PointCloud2 reading without a ROS master: float32 and float64 x/y/z, organised clouds with
+// NaN, and malformed messages that must give a clear CloudError instead of a crash.
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include <sensor_msgs/point_cloud2_iterator.h>
+
+#include "cube_scan_matcher/core/filters.h"
+#include "cube_scan_matcher/ros/cloud_conversion.h"
+
+using namespace cube_scan_matcher;
+
+namespace {
+
+sensor_msgs::PointCloud2 doubleCloud(std::size_t n) {
+  sensor_msgs::PointCloud2 c;
+  sensor_msgs::PointCloud2Modifier m(c);
+  m.setPointCloud2Fields(4, "x", 1, sensor_msgs::PointField::FLOAT64, "y", 1,
+                         sensor_msgs::PointField::FLOAT64, "intensity", 1,
+                         sensor_msgs::PointField::FLOAT32, "z", 1,
+                         sensor_msgs::PointField::FLOAT64);
+  m.resize(n);
+  sensor_msgs::PointCloud2Iterator<double> x(c, "x"), y(c, "y"), z(c, "z");
+  for (std::size_t i = 0; i < n; ++i, ++x, ++y, ++z) *x = double(i), *y = 2.0 * double(i), *z = -1.0;
+  return c;
+}
+
+}  // namespace
+
+TEST(CloudConversion, RoundTripsFloat32AndAppliesTheTransform) {
+  PointArray p;
+  p.push_back(1, 2, 3);
+  p.push_back(-4, 5, 0.5f);
+  Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
+  T.translation() = Eigen::Vector3d(10, 0, 0);
+  const sensor_msgs::PointCloud2 c = toCloud(p, Eigen::Isometry3d::Identity(), std_msgs::Header{});
+  const PointArray q = fromCloud(c, T);
+  ASSERT_EQ(q.size(), 2u);
+  EXPECT_FLOAT_EQ(q.x[0], 11.0f);
+  EXPECT_FLOAT_EQ(q.y[1], 5.0f);
+  EXPECT_FLOAT_EQ(q.z[1], 0.5f);
+}
+
+TEST(CloudConversion, ReadsFloat64WithOtherFieldsBetween) {
+  const PointArray q = fromCloud(doubleCloud(5));
+  ASSERT_EQ(q.size(), 5u);
+  EXPECT_FLOAT_EQ(q.x[4], 4.0f);
+  EXPECT_FLOAT_EQ(q.y[4], 8.0f);
+  EXPECT_FLOAT_EQ(q.z[4], -1.0f);
+}
+
+TEST(CloudConversion, OrganisedNaNPointsAreKeptForTheFilterToDrop) {
+  PointArray p;
+  p.push_back(1, 1, 1);
+  p.push_back(NAN, NAN, NAN);
+  sensor_msgs::PointCloud2 c = toCloud(p, Eigen::Isometry3d::Identity(), std_msgs::Header{});
+  const PointArray q = fromCloud(c);
+  ASSERT_EQ(q.size(), 2u);
+  FilterStats stats;
+  EXPECT_EQ(filterPoints(q, RangeFilterSettings{}, &stats).size(), 1u);
+  EXPECT_EQ(stats.non_finite, 1u);
+}
+
+TEST(CloudConversion, MalformedCloudsGiveAClearError) {
+  sensor_msgs::PointCloud2 noxyz;
+  sensor_msgs::PointCloud2Modifier(noxyz).setPointCloud2FieldsByString(1, "rgb");
+  sensor_msgs::PointCloud2Modifier(noxyz).resize(3);
+  try {
+    fromCloud(noxyz);
+    FAIL() << "no error";
+  } catch (const CloudError& e) {
+    EXPECT_NE(std::string(e.what()).find("no x/y/z"), std::string::npos) << e.what();
+  }
+  sensor_msgs::PointCloud2 truncated = doubleCloud(100);
+  truncated.data.resize(truncated.data.size() / 2);
+  EXPECT_THROW(fromCloud(truncated), CloudError);
+  sensor_msgs::PointCloud2 ints = doubleCloud(3);
+  for (auto& f : ints.fields) f.datatype = sensor_msgs::PointField::INT32;
+  EXPECT_THROW(fromCloud(ints), CloudError);
+  sensor_msgs::PointCloud2 empty = doubleCloud(0);
+  EXPECT_TRUE(fromCloud(empty).empty());
+}
