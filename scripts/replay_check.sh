@@ -7,11 +7,12 @@
 set -eo pipefail
 DIR="$1"; T_ERR="${2:-0.5}"; A_ERR="${3:-5}"
 ROOT="$(cd "$(dirname "$0")/.." && pwd)"
+BUILD="${CSM_BUILD_DIR:-$ROOT/build}"   # the build directory (CTest passes its own)
 export PATH=/usr/sbin:/usr/bin:/sbin:/bin:$PATH
-source "$ROOT/build/devel/setup.bash"
+source "$BUILD/devel/setup.bash"
 WORK="$(mktemp -d)"
 trap 'kill $LAUNCH_PID 2>/dev/null || true; wait 2>/dev/null || true; rm -rf "$WORK"' EXIT
-"$ROOT/build/devel/lib/cube_scan_matcher/clouds_to_bag" "$WORK/replay.bag" --dataset "$DIR" \
+"$BUILD/devel/lib/cube_scan_matcher/clouds_to_bag" "$WORK/replay.bag" --dataset "$DIR" \
   --odometry-error "$T_ERR" "$A_ERR" --rate 0.5 > "$WORK/bag.log"
 N=$(grep -c " points at " "$WORK/bag.log")
 export ROS_MASTER_URI=http://localhost:$((11400 + RANDOM % 500))

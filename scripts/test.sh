@@ -2,7 +2,9 @@
 # The README's test command: installs, builds and runs the whole test suite through CTest.
 # With DATA_DIR (a folder laid out like shared/data: sub-folders with pairs.txt), it also runs
 # the real-data accuracy check: the cube method with the default settings must succeed
-# (Es < 0.10 m and Ea < 1 deg) in at least 8 of 10 trials from +-1 m / +-8 deg on every pair.
+# (Es < 0.10 m and Ea < 1 deg) in at least 8 of 10 trials from +-1 m / +-8 deg on every pair,
+# and every folder, written into a bag with clouds_to_bag (odometry off by +-0.5 m / +-5 deg),
+# must replay through launch/bag_replay.launch with every registration accepted.
 #   usage: scripts/test.sh [DATA_DIR]
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -24,6 +26,7 @@ if [ -n "$DATA_DIR" ]; then
     [ -f "$d/pairs.txt" ] || continue
     build/devel/lib/cube_scan_matcher/benchmark "$d" --methods cubes --trials 10 \
       --require-success 8 --csv "build/accuracy_$(basename "$d").csv" 2>/dev/null || status=1
+    bash scripts/replay_check.sh "$d" || status=1
   done
 else
   echo "== real-data accuracy check NOT run: no DATA_DIR given (CI passes ../shared/data)"
