@@ -23,6 +23,7 @@
 #include "cube_scan_matcher/Status.h"
 #include "cube_scan_matcher/core/pose.h"
 #include "cube_scan_matcher/ros/cloud_conversion.h"
+#include "cube_scan_matcher/ros/params.h"
 #include "cube_scan_matcher/sim/tilting_scanner.h"
 
 using namespace cube_scan_matcher;
@@ -110,6 +111,24 @@ class ScanMatcherRos : public ::testing::Test {
     return out.status.empty() ? Status{} : out.status.back();
   }
 };
+
+// config/scan_matcher.yaml, loaded by the .test files, holds the code's defaults (the .test
+// files override tf_timeout only).
+TEST(ScanMatcherYaml, LoadsAndEqualsTheDefaults) {
+  NodeParams p;
+  ASSERT_NO_THROW(p = loadParams(ros::NodeHandle(kNs)));
+  const ScanMatcherConfig yaml = toConfig(p), code = toConfig(NodeParams{});
+  EXPECT_DOUBLE_EQ(yaml.cube_edge, code.cube_edge);
+  EXPECT_EQ(yaml.starts, code.starts);
+  EXPECT_DOUBLE_EQ(yaml.collapse_fraction, code.collapse_fraction);
+  EXPECT_EQ(yaml.refine_grids, code.refine_grids);
+  EXPECT_DOUBLE_EQ(yaml.min_overlap, code.min_overlap);
+  EXPECT_DOUBLE_EQ(yaml.max_correction_rotation, code.max_correction_rotation);
+  EXPECT_EQ(p.base_frame, "base_link");
+  EXPECT_EQ(p.queue_size, 1);
+  EXPECT_EQ(p.path_max_length, NodeParams{}.path_max_length);
+  EXPECT_DOUBLE_EQ(p.sigma_translation, NodeParams{}.sigma_translation);
+}
 
 TEST_F(ScanMatcherRos, RegistersSimulatedSweepsToTheTruth) {
   const sim::Scene scene = sim::Scene::generate(sim::SceneType::Urban, 3);
