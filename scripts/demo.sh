@@ -5,10 +5,5 @@
 # go to roslaunch, e.g. scene:=park sweeps:=20 rviz:=true odometry_error:=drift.
 set -euo pipefail
 cd "$(dirname "$0")/.."
-bash scripts/install_deps.sh
-bash scripts/build.sh
-export PATH=/usr/sbin:/usr/bin:/sbin:/bin:$PATH
-set +u  # ROS setup scripts read unset variables
-source build/devel/setup.bash
-set -u
+source scripts/env.sh  # install, build, ROS environment
 exec roslaunch cube_scan_matcher demo.launch "$@"

@@ -13,12 +13,7 @@ if [ -n "$DATA_DIR" ] && [ ! -d "$DATA_DIR" ]; then
   echo "test: DATA_DIR '$DATA_DIR' is not a directory" >&2
   exit 2
 fi
-bash scripts/install_deps.sh
-bash scripts/build.sh
-export PATH=/usr/sbin:/usr/bin:/sbin:/bin:$PATH
-set +u  # ROS setup scripts read unset variables
-source build/devel/setup.bash
-set -u
+source scripts/env.sh  # install, build, ROS environment
 status=0
 if [ -n "$DATA_DIR" ]; then
   echo "== real-data accuracy check on $DATA_DIR"

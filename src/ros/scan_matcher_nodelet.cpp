@@ -13,6 +13,7 @@
 #include "cube_scan_matcher/Status.h"
 #include "cube_scan_matcher/core/filters.h"
 #include "cube_scan_matcher/ros/cloud_conversion.h"
+#include "cube_scan_matcher/ros/transforms.h"
 
 namespace cube_scan_matcher {
 namespace {
@@ -309,10 +310,8 @@ void ScanMatcherNodelet::processCloud(const sensor_msgs::PointCloud2& msg, doubl
 
   if (tf_broadcaster_ && odom) {
     // REP-105: map -> odom such that map -> odom -> base_link equals the registered pose.
-    geometry_msgs::TransformStamped t = tf2::eigenToTransform(step.pose * odom->inverse());
-    t.header = header;
-    t.child_frame_id = params_.odom_frame;
-    tf_broadcaster_->sendTransform(t);
+    tf_broadcaster_->sendTransform(stampedTransform(step.pose * odom->inverse(), params_.map_frame,
+                                                    params_.odom_frame, stamp));
   }
   publishStatus(step.reason, step.message);
 }

@@ -14,6 +14,7 @@
 #include <tf2_ros/transform_broadcaster.h>
 
 #include "cube_scan_matcher/ros/cloud_conversion.h"
+#include "cube_scan_matcher/ros/transforms.h"
 #include "cube_scan_matcher/sim/motion.h"
 #include "cube_scan_matcher/sim/tilting_scanner.h"
 
@@ -29,15 +30,6 @@ T param(ros::NodeHandle& pnh, const std::string& name, T value, T lo, T hi) {
                                 ", " + std::to_string(hi) + "]");
   }
   return value;
-}
-
-geometry_msgs::TransformStamped stamped(const Eigen::Isometry3d& T, const std::string& parent,
-                                        const std::string& child, const ros::Time& stamp) {
-  geometry_msgs::TransformStamped t = tf2::eigenToTransform(T);
-  t.header.stamp = stamp;
-  t.header.frame_id = parent;
-  t.child_frame_id = child;
-  return t;
 }
 
 /// An organised cloud (height = 2D scans, width = beams per scan) with NaN for no return.
@@ -94,7 +86,7 @@ int main(int argc, char** argv) {
     Eigen::Isometry3d mount = Eigen::Isometry3d::Identity();
     mount.linear() = sim::sensorToBodyRotation();
     mount.translation() = Eigen::Vector3d(0.1, 0.0, 0.4);  // scanner 0.4 m above base_link
-    static_pub.sendTransform(stamped(mount, base_frame, scanner_frame, ros::Time(0)));
+    static_pub.sendTransform(stampedTransform(mount, base_frame, scanner_frame, ros::Time(0)));
     ROS_INFO("simulator: %s scene (seed %d), %d x %d beams, odometry errors '%s', a sweep every %.2f s",
              scene_name.c_str(), seed, model.phiCount(), model.psiCount(), odom_mode.c_str(), period);
 
@@ -112,7 +104,7 @@ int main(int argc, char** argv) {
       options.keep_invalid = organized;
       const PointArray pts = sim::scan(scene, model, truth * mount, rng, options);
       const ros::Time stamp = ros::Time::now();
-      tf_pub.sendTransform(stamped(odom, odom_frame, base_frame, stamp));
+      tf_pub.sendTransform(stampedTransform(odom, odom_frame, base_frame, stamp));
       geometry_msgs::PoseStamped gt;
       gt.header.stamp = stamp;
       gt.header.frame_id = map_frame;

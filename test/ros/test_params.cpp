@@ -3,29 +3,12 @@
 #include <gtest/gtest.h>
 
 #include "cube_scan_matcher/ros/params.h"
+#include "expect_params.h"
 
 using namespace cube_scan_matcher;
 
 TEST(Params, ReconfigureDefaultsEqualTheCoreDefaults) {
-  const ScanMatcherConfig cfg = ScanMatcherConfig::__getDefault__();
-  const ScanMatcherConfig code = toConfig(NodeParams{});
-  EXPECT_DOUBLE_EQ(cfg.cube_edge, code.cube_edge);
-  EXPECT_EQ(cfg.vertices, code.vertices);
-  EXPECT_EQ(cfg.iterations, code.iterations);
-  EXPECT_NEAR(cfg.bounds_translation, code.bounds_translation, 1e-12);
-  EXPECT_NEAR(cfg.bounds_rotation, code.bounds_rotation, 1e-9);
-  EXPECT_EQ(cfg.starts, code.starts);
-  EXPECT_EQ(cfg.threads, code.threads);
-  EXPECT_DOUBLE_EQ(cfg.collapse_fraction, code.collapse_fraction);
-  EXPECT_EQ(cfg.refine, code.refine);
-  EXPECT_DOUBLE_EQ(cfg.refine_edge_fraction, code.refine_edge_fraction);
-  EXPECT_EQ(cfg.refine_grids, code.refine_grids);
-  EXPECT_EQ(cfg.seed, code.seed);
-  EXPECT_DOUBLE_EQ(cfg.min_overlap, code.min_overlap);
-  EXPECT_EQ(cfg.min_j_gain, code.min_j_gain);
-  EXPECT_NEAR(cfg.max_correction_translation, code.max_correction_translation, 1e-12);
-  EXPECT_NEAR(cfg.max_correction_rotation, code.max_correction_rotation, 1e-9);
-  EXPECT_EQ(cfg.max_consecutive_rejections, code.max_consecutive_rejections);
+  expectSameLiveParams(ScanMatcherConfig::__getDefault__(), toConfig(NodeParams{}));
 }
 
 TEST(Params, AnInvalidCombinationIsRefusedAndLeavesTheParamsUnchanged) {

@@ -23,6 +23,8 @@
 #include "cube_scan_matcher/Status.h"
 #include "cube_scan_matcher/core/pose.h"
 #include "cube_scan_matcher/ros/cloud_conversion.h"
+#include "cube_scan_matcher/ros/transforms.h"
+#include "expect_params.h"
 #include "cube_scan_matcher/ros/params.h"
 #include "cube_scan_matcher/sim/tilting_scanner.h"
 
@@ -69,15 +71,6 @@ bool waitFor(F done, double timeout) {
   return done();
 }
 
-geometry_msgs::TransformStamped stamped(const Eigen::Isometry3d& T, const std::string& parent,
-                                        const std::string& child, const ros::Time& stamp) {
-  geometry_msgs::TransformStamped t = tf2::eigenToTransform(T);
-  t.header.stamp = stamp;
-  t.header.frame_id = parent;
-  t.child_frame_id = child;
-  return t;
-}
-
 sensor_msgs::PointCloud2 makeCloud(const PointArray& pts, const std::string& frame,
                                    const ros::Time& stamp) {
   std_msgs::Header h;
@@ -117,13 +110,7 @@ class ScanMatcherRos : public ::testing::Test {
 TEST(ScanMatcherYaml, LoadsAndEqualsTheDefaults) {
   NodeParams p;
   ASSERT_NO_THROW(p = loadParams(ros::NodeHandle(kNs)));
-  const ScanMatcherConfig yaml = toConfig(p), code = toConfig(NodeParams{});
-  EXPECT_DOUBLE_EQ(yaml.cube_edge, code.cube_edge);
-  EXPECT_EQ(yaml.starts, code.starts);
-  EXPECT_DOUBLE_EQ(yaml.collapse_fraction, code.collapse_fraction);
-  EXPECT_EQ(yaml.refine_grids, code.refine_grids);
-  EXPECT_DOUBLE_EQ(yaml.min_overlap, code.min_overlap);
-  EXPECT_DOUBLE_EQ(yaml.max_correction_rotation, code.max_correction_rotation);
+  expectSameLiveParams(toConfig(p), toConfig(NodeParams{}));
   EXPECT_EQ(p.base_frame, "base_link");
   EXPECT_EQ(p.queue_size, 1);
   EXPECT_EQ(p.path_max_length, NodeParams{}.path_max_length);
@@ -138,7 +125,7 @@ TEST_F(ScanMatcherRos, RegistersSimulatedSweepsToTheTruth) {
   Eigen::Isometry3d mount = Eigen::Isometry3d::Identity();
   mount.linear() = sim::sensorToBodyRotation();
   mount.translation() = Eigen::Vector3d(0.2, 0.0, 0.5);
-  static_pub.sendTransform(stamped(mount, "base_link", "laser", ros::Time(0)));
+  static_pub.sendTransform(stampedTransform(mount, "base_link", "laser", ros::Time(0)));
 
   Eigen::Isometry3d truth = Eigen::Isometry3d::Identity(), odom = Eigen::Isometry3d::Identity();
   truth.linear() = rotationFromRpy(0.01, -0.01, deg2rad(17));
@@ -162,7 +149,7 @@ TEST_F(ScanMatcherRos, RegistersSimulatedSweepsToTheTruth) {
     }
     truths.push_back(truth);
     const ros::Time stamp = t0 + ros::Duration(0.5 * (k + 1));
-    tf_pub.sendTransform(stamped(odom, "odom", "base_link", stamp));
+    tf_pub.sendTransform(stampedTransform(odom, "odom", "base_link", stamp));
     waitFor([] { return false; }, 0.2);  // tf reaches the matcher before the cloud
     const PointArray pts = sim::scan(scene, model, truth * mount, rng);
     const Status s = send(makeCloud(pts, "laser", stamp));
@@ -218,7 +205,7 @@ TEST_F(ScanMatcherRos, BadInputKeepsTheNodeAliveAndIsReported) {
   ros::Time stamp = ros::Time::now();
   auto next = [&] {
     stamp += ros::Duration(0.5);
-    tf_pub.sendTransform(stamped(Eigen::Isometry3d::Identity(), "odom", "base_link", stamp));
+    tf_pub.sendTransform(stampedTransform(Eigen::Isometry3d::Identity(), "odom", "base_link", stamp));
     waitFor([] { return false; }, 0.1);
     return stamp;
   };
