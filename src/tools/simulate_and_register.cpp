@@ -11,6 +11,7 @@
 
 #include "cube_scan_matcher/core/defaults.h"
 #include "cube_scan_matcher/core/registration.h"
+#include "cube_scan_matcher/sim/motion.h"
 #include "cube_scan_matcher/sim/tilting_scanner.h"
 #include "dataset.h"
 #include "settings_cli.h"
@@ -21,7 +22,7 @@ int main(int argc, char** argv) {
   std::vector<std::string> args(argv + 1, argv + argc);
   std::string scene_name = "urban";
   int sweeps = 6;
-  double err_t = 0.25, err_a = 2.0;
+  std::string odometry_error = "small";
   std::uint64_t seed = 1;
   RegistrationSettings settings = defaultSettings();
   RangeFilterSettings filter;
@@ -32,8 +33,9 @@ int main(int argc, char** argv) {
         std::cout << "usage: simulate_and_register [options]\n"
                      "  --scene NAME          hall, urban, park or natural (default urban)\n"
                      "  --sweeps N            sweeps to simulate (default 6)\n"
-                     "  --odometry-error B    small (+-0.25 m, +-2 deg) or big (+-1 m, +-8 deg)\n"
-                     "                        uniform errors on each odometry increment (default small)\n"
+                     "  --odometry-error B    none, small (+-0.25 m, +-2 deg), big (+-1 m, +-8 deg)\n"
+                     "                        uniform errors on each odometry increment, or drift\n"
+                     "                        (default small)\n"
                      "  --scene-seed N        seed of the world and the noise (default 1)\n"
                   << tools::algorithmOptionsHelp();
         return 0;
@@ -44,43 +46,37 @@ int main(int argc, char** argv) {
       if (a == "--scene") scene_name = v;
       else if (a == "--sweeps") sweeps = int(tools::parseNumber(a, v));
       else if (a == "--scene-seed") seed = std::uint64_t(tools::parseNumber(a, v));
-      else if (a == "--odometry-error" && v == "small") err_t = 0.25, err_a = 2.0;
-      else if (a == "--odometry-error" && v == "big") err_t = 1.0, err_a = 8.0;
+      else if (a == "--odometry-error") odometry_error = v;
       else throw std::invalid_argument("unknown option or value: " + a + " " + v);
       i += 2;
     }
     if (sweeps < 2) throw std::invalid_argument("--sweeps must be >= 2");
     const sim::Scene scene = sim::Scene::generate(sim::sceneTypeFromString(scene_name), seed);
     const sim::ScannerModel model;
+    sim::RobotMotion robot(scene, sim::MotionSettings{}, seed + 1);
+    sim::OdometrySimulator odometry(sim::odometryErrorFromString(odometry_error), seed + 2);
     std::mt19937_64 rng(seed);
-    std::uniform_real_distribution<double> u(-1.0, 1.0);
     Eigen::Isometry3d mount = Eigen::Isometry3d::Identity();
     mount.linear() = sim::sensorToBodyRotation();
-    Eigen::Isometry3d body = Eigen::Isometry3d::Identity();
-    body.linear() = rotationFromRpy(0.01, -0.01, deg2rad(10));
-    body.translation() = Eigen::Vector3d(0, 0, scene.groundHeight(0, 0) + 1.0);
 
+    // Registration in the sensor frame: the scan of sweep k to that of sweep k-1.
     CubeRegistration reg(settings);
-    Eigen::Isometry3d prev_sensor = body * mount;
+    Eigen::Isometry3d prev_sensor = robot.pose() * mount;
+    Eigen::Isometry3d prev_odom = odometry.next(robot.pose()) * mount;
     reg.setReference(filterPoints(sim::scan(scene, model, prev_sensor, rng), filter));
-    std::printf("scene %s, %d sweeps of %d x %d beams, odometry errors +-%.2f m / +-%.0f deg\n",
-                scene_name.c_str(), sweeps, model.phiCount(), model.psiCount(), err_t, err_a);
+    std::printf("scene %s, %d sweeps of %d x %d beams, odometry errors: %s\n", scene_name.c_str(),
+                sweeps, model.phiCount(), model.psiCount(), odometry_error.c_str());
     std::printf("%5s %8s %10s %10s %10s %10s %8s %8s %8s\n", "sweep", "points", "Es guess",
                 "Es [m]", "Ea [deg]", "time [s]", "J/l", "J", "J truth");
     std::vector<double> es, ea;
     int ok = 0;
     for (int k = 1; k < sweeps; ++k) {
-      Eigen::Isometry3d step = Eigen::Isometry3d::Identity();
-      step.translation() = Eigen::Vector3d(2.0 + 1.0 * u(rng), 0.3 * u(rng), 0.0);
-      step.linear() = rotationFromRpy(0.01 * u(rng), 0.01 * u(rng), deg2rad(8.0 * u(rng)));
-      body = body * step;
-      body.translation().z() = scene.groundHeight(body.translation().x(), body.translation().y()) + 1.0;
-      const Eigen::Isometry3d sensor = body * mount;
+      robot.advance();
+      const Eigen::Isometry3d sensor = robot.pose() * mount;
+      const Eigen::Isometry3d odom = odometry.next(robot.pose()) * mount;
       const PointArray pts = filterPoints(sim::scan(scene, model, sensor, rng), filter);
       const Eigen::Isometry3d truth = prev_sensor.inverse() * sensor;
-      Pose6 guess = isometryToPose(truth);
-      for (int i = 0; i < 3; ++i) guess[i] += err_t * u(rng);
-      for (int i = 3; i < 6; ++i) guess[i] += deg2rad(err_a) * u(rng);
+      const Pose6 guess = isometryToPose(prev_odom.inverse() * odom);
       const RegistrationResult r = reg.align(pts, guess);
       const tools::PoseError e = tools::poseError(r.transform, truth);
       const tools::PoseError eg = tools::poseError(poseToIsometry(guess), truth);
@@ -92,6 +88,7 @@ int main(int argc, char** argv) {
                   e.es_m, e.ea_deg, r.time_s, r.overlap(), r.J, j_truth);
       reg.setReference(pts);
       prev_sensor = sensor;
+      prev_odom = odom;
     }
     auto med = [](std::vector<double> v) {
       std::sort(v.begin(), v.end());
