@@ -29,6 +29,10 @@ void validate(const RegistrationSettings& s) {
                                   std::to_string(s.refine.edge_fraction));
     }
     validate(s.refine.compass);
+    if (!(s.refine.coarse_weight >= 0.0 && s.refine.coarse_weight <= 100.0)) {
+      throw std::invalid_argument("refine coarse_weight must be in [0, 100], got " +
+                                  std::to_string(s.refine.coarse_weight));
+    }
     if (s.refine.candidates < 1 || s.refine.candidates > 64) {
       throw std::invalid_argument("refine candidates must be in [1, 64], got " +
                                   std::to_string(s.refine.candidates));
@@ -259,10 +263,14 @@ RegistrationResult CubeRegistration::align(const PointArray& scan, const Pose6& 
     std::vector<CoincidenceObjective> fine;
     fine.reserve(fine_grids_.size());
     for (const CubeGrid& grid : fine_grids_) fine.emplace_back(grid, fine_points);
-    auto fine_j = [&fine](const Vector6d& p) {
+    // Multi-scale: the coarse cubes (weighted) join the fine grids' sum, so the refine stage
+    // cannot trade coarse-level agreement for a fine-level near-tie.
+    const double w = settings_.refine.coarse_weight;
+    CoincidenceObjective coarse_on_fine(grid_, fine_points);
+    auto fine_j = [&fine, &coarse_on_fine, w](const Vector6d& p) {
       int sum = 0;
       for (CoincidenceObjective& j : fine) sum += j(p);
-      return double(sum);
+      return double(sum) + (w > 0.0 ? w * coarse_on_fine(p) : 0.0);
     };
     // Refine the best `candidates` distinct coarse results (the winner first) and keep the
     // highest fine J: the finer cubes settle near-ties of the coarse J.

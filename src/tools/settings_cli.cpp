@@ -38,6 +38,8 @@ std::string algorithmOptionsHelp() {
          "                        0 = all points as in the paper (default " + num(d.collapse_fraction) + ")\n"
          "  --refine F            compass-search stage on cubes of F*E from the coarse result,\n"
          "                        0 = off as in the paper (default " + num(d.refine.enabled ? d.refine.edge_fraction : 0.0) + ")\n"
+         "  --refine-coarse-weight W  the refine objective adds W x J on the E grid\n"
+         "                        (default " + num(d.refine.coarse_weight) + "; 0 = fine grids only)\n"
          "  --refine-candidates K refine the K best distinct coarse results, keep the best\n"
          "                        (default " + std::to_string(d.refine.candidates) + ")\n"
          "  --refine-collapse F   the refine stage evaluates one point per voxel of F*E\n"
@@ -89,6 +91,8 @@ bool parseAlgorithmOption(const std::vector<std::string>& args, std::size_t& i,
     s.refine.enabled = value(1) > 0.0;
     if (s.refine.enabled) s.refine.edge_fraction = value(1);
     used = 2;
+  } else if (a == "--refine-coarse-weight") {
+    s.refine.coarse_weight = value(1), used = 2;
   } else if (a == "--refine-candidates") {
     s.refine.candidates = int(value(1)), used = 2;
   } else if (a == "--refine-collapse") {

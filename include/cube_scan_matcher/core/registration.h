@@ -25,6 +25,9 @@ struct RefineSettings {
   /// Fine grids with origins shifted by k/grids of a fine cube, k = 0..grids-1; the refine
   /// objective is the sum of their J (anti-aliasing). In [1, 8].
   int grids = 1;
+  /// Weight of J on the coarse grid (edge E) added to the fine grids' sum; 0 = fine grids
+  /// only. In [0, 100].
+  double coarse_weight = 0.0;
   /// Distinct coarse results (of the independent starts, by decreasing J) refined; the highest
   /// fine J wins. In [1, 64].
   int candidates = 1;
