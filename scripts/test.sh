@@ -2,7 +2,7 @@
 # The README's test command: installs, builds and runs the whole test suite through CTest.
 # With DATA_DIR (a folder laid out like shared/data: sub-folders with pairs.txt), it also runs
 # the real-data accuracy check: the cube method with the default settings must succeed
-# (Es < 0.10 m and Ea < 1 deg) in at least 8 of 10 trials from +-1 m / +-8 deg on every pair,
+# (Es < 0.10 m and Ea < 1 deg) in at least 24 of 25 trials from +-1 m / +-8 deg on every pair,
 # and every folder, written into a bag with clouds_to_bag (odometry off by +-0.5 m / +-5 deg),
 # must replay through launch/bag_replay.launch with every registration accepted.
 #   usage: scripts/test.sh [DATA_DIR]
@@ -19,8 +19,8 @@ if [ -n "$DATA_DIR" ]; then
   echo "== real-data accuracy check on $DATA_DIR"
   for d in "$DATA_DIR"/*/; do
     [ -f "$d/pairs.txt" ] || continue
-    build/devel/lib/cube_scan_matcher/benchmark "$d" --methods cubes --trials 10 \
-      --require-success 8 --csv "build/accuracy_$(basename "$d").csv" 2>/dev/null || status=1
+    build/devel/lib/cube_scan_matcher/benchmark "$d" --methods cubes --trials 25 \
+      --require-success 24 --csv "build/accuracy_$(basename "$d").csv" 2>/dev/null || status=1
     bash scripts/replay_check.sh "$d" || status=1
   done
 else
