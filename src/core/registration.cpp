@@ -3,8 +3,9 @@
 #include <algorithm>
 #include <chrono>
 #include <memory>
-#include <thread>
+#include <optional>
 #include <sstream>
+#include <thread>
 #include <stdexcept>
 
 #include "cube_scan_matcher/core/coincidence_objective.h"
@@ -20,6 +21,27 @@ RegistrationSettings RegistrationSettings::paper(double cube_edge) {
   return s;
 }
 
+namespace {
+
+/// Throws std::invalid_argument "<name> must be in [lo, hi], got <value>" (NaN fails too).
+template <typename T>
+void requireInRange(const char* name, T value, T lo, T hi) {
+  if (!(value >= lo && value <= hi)) {
+    std::ostringstream os;
+    os << name << " must be in [" << lo << ", " << hi << "], got " << value;
+    throw std::invalid_argument(os.str());
+  }
+}
+
+/// Two poses within the search's agreement tolerances (translation norm, each angle).
+bool samePose(const Vector6d& a, const Vector6d& b, const SearchSettings& ss) {
+  const Vector6d d = a - b;
+  return d.head<3>().norm() <= ss.consensus_translation &&
+         d.tail<3>().cwiseAbs().maxCoeff() <= ss.consensus_rotation;
+}
+
+}  // namespace
+
 void validate(const RegistrationSettings& s) {
   validate(s.grid);
   validate(s.gnmm);
@@ -29,50 +51,20 @@ void validate(const RegistrationSettings& s) {
                                   std::to_string(s.refine.edge_fraction));
     }
     validate(s.refine.compass);
-    if (!(s.refine.coarse_weight >= 0.0 && s.refine.coarse_weight <= 100.0)) {
-      throw std::invalid_argument("refine coarse_weight must be in [0, 100], got " +
-                                  std::to_string(s.refine.coarse_weight));
-    }
-    if (s.refine.candidates < 1 || s.refine.candidates > 64) {
-      throw std::invalid_argument("refine candidates must be in [1, 64], got " +
-                                  std::to_string(s.refine.candidates));
-    }
-    if (s.refine.grids < 1 || s.refine.grids > 8) {
-      throw std::invalid_argument("refine grids must be in [1, 8], got " +
-                                  std::to_string(s.refine.grids));
-    }
+    requireInRange("refine coarse_weight", s.refine.coarse_weight, 0.0, 100.0);
+    requireInRange("refine candidates", s.refine.candidates, 1, 64);
+    requireInRange("refine grids", s.refine.grids, 1, 8);
+    requireInRange("refine collapse_fraction", s.refine.collapse_fraction, 0.0, 1.0);
   }
-  if (s.search.starts < 1 || s.search.starts > 64) {
-    throw std::invalid_argument("search starts must be in [1, 64], got " +
-                                std::to_string(s.search.starts));
-  }
-  if (s.search.threads < 1 || s.search.threads > 64) {
-    throw std::invalid_argument("search threads must be in [1, 64], got " +
-                                std::to_string(s.search.threads));
-  }
-  if (s.search.consensus < 0 || s.search.consensus > 64) {
-    throw std::invalid_argument("search consensus must be in [0, 64], got " +
-                                std::to_string(s.search.consensus));
-  }
+  requireInRange("search starts", s.search.starts, 1, 64);
+  requireInRange("search threads", s.search.threads, 1, 64);
+  requireInRange("search consensus", s.search.consensus, 0, 64);
   if (!(s.search.consensus_translation > 0.0 && s.search.consensus_rotation > 0.0)) {
     throw std::invalid_argument("search consensus tolerances must be > 0");
   }
-  if (s.search.polish_runs < 0 || s.search.polish_runs > 10) {
-    throw std::invalid_argument("search polish_runs must be in [0, 10], got " +
-                                std::to_string(s.search.polish_runs));
-  }
-  if (s.search.polish_iterations < 1 || s.search.polish_iterations > 1000000) {
-    throw std::invalid_argument("search polish_iterations must be in [1, 1000000], got " +
-                                std::to_string(s.search.polish_iterations));
-  }
-  if (s.refine.enabled && !(s.refine.collapse_fraction >= 0.0 && s.refine.collapse_fraction <= 1.0)) {
-    throw std::invalid_argument("refine collapse_fraction must be in [0, 1], got " +
-                                std::to_string(s.refine.collapse_fraction));
-  }
-  if (!(s.collapse_fraction >= 0.0 && s.collapse_fraction <= 1.0)) {
-    throw std::invalid_argument("collapse_fraction must be in [0, 1], got " +
-                                std::to_string(s.collapse_fraction));
-  }
+  requireInRange("search polish_runs", s.search.polish_runs, 0, 10);
+  requireInRange("search polish_iterations", s.search.polish_iterations, 1, 1000000);
+  requireInRange("collapse_fraction", s.collapse_fraction, 0.0, 1.0);
 }
 
 std::string toString(RegistrationStatus status) {
@@ -160,42 +152,34 @@ GnmmResult CubeRegistration::coarseSearch(const PointArray& points, const Pose6&
           runs.begin(), runs.end(),
           [](const GnmmResult& a, const GnmmResult& b) { return a.best_value < b.best_value; });
       int agree = 0;
-      for (const GnmmResult& r : runs) {
-        const Vector6d d = r.best - top.best;
-        agree += d.head<3>().norm() <= ss.consensus_translation &&
-                 d.tail<3>().cwiseAbs().maxCoeff() <= ss.consensus_rotation;
-      }
+      for (const GnmmResult& r : runs) agree += samePose(r.best, top.best, ss);
       if (agree >= ss.consensus) break;
     }
   }
 
   int evaluations = 0, iterations = 0, restarts = 0;
-  std::size_t winner = 0;
-  for (std::size_t k = 0; k < runs.size(); ++k) {
-    evaluations += runs[k].evaluations;
-    iterations += runs[k].iterations;
-    restarts += runs[k].restarts;
-    if (runs[k].best_value > runs[winner].best_value) winner = k;
+  for (const GnmmResult& r : runs) {
+    evaluations += r.evaluations;
+    iterations += r.iterations;
+    restarts += r.restarts;
   }
-  // Distinct start results by decreasing J: candidates for the refine stage.
+  // Starts by decreasing J (ties: lowest k first); the first is the winner, and the distinct
+  // results in this order are the candidates of the refine stage.
+  std::vector<std::size_t> order(runs.size());
+  for (std::size_t k = 0; k < order.size(); ++k) order[k] = k;
+  std::stable_sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) {
+    return runs[a].best_value > runs[b].best_value;
+  });
   if (candidates) {
-    std::vector<std::size_t> order(runs.size());
-    for (std::size_t k = 0; k < order.size(); ++k) order[k] = k;
-    std::stable_sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) {
-      return runs[a].best_value > runs[b].best_value;
-    });
     candidates->clear();
     for (std::size_t k : order) {
-      bool distinct = true;
-      for (const Vector6d& c : *candidates) {
-        const Vector6d d = runs[k].best - c;
-        distinct = distinct && !(d.head<3>().norm() <= ss.consensus_translation &&
-                                 d.tail<3>().cwiseAbs().maxCoeff() <= ss.consensus_rotation);
-      }
+      const bool distinct = std::none_of(
+          candidates->begin(), candidates->end(),
+          [&](const Vector6d& c) { return samePose(runs[k].best, c, ss); });
       if (distinct) candidates->push_back(runs[k].best);
     }
   }
-  GnmmResult best = std::move(runs[winner]);
+  GnmmResult best = std::move(runs[order.front()]);
   best.initial_value = runs[0].initial_value;
 
   // Polish: GNMM around the best pose so far with the bounds halved at each run.
@@ -266,11 +250,12 @@ RegistrationResult CubeRegistration::align(const PointArray& scan, const Pose6& 
     // Multi-scale: the coarse cubes (weighted) join the fine grids' sum, so the refine stage
     // cannot trade coarse-level agreement for a fine-level near-tie.
     const double w = settings_.refine.coarse_weight;
-    CoincidenceObjective coarse_on_fine(grid_, fine_points);
+    std::optional<CoincidenceObjective> coarse_on_fine;
+    if (w > 0.0) coarse_on_fine.emplace(grid_, fine_points);
     auto fine_j = [&fine, &coarse_on_fine, w](const Vector6d& p) {
       int sum = 0;
       for (CoincidenceObjective& j : fine) sum += j(p);
-      return double(sum) + (w > 0.0 ? w * coarse_on_fine(p) : 0.0);
+      return double(sum) + (coarse_on_fine ? w * (*coarse_on_fine)(p) : 0.0);
     };
     // Refine the best `candidates` distinct coarse results (the winner first) and keep the
     // highest fine J: the finer cubes settle near-ties of the coarse J.

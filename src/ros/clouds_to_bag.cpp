@@ -9,12 +9,12 @@
 #include <sstream>
 
 #include <rosbag/bag.h>
-#include <tf2_eigen/tf2_eigen.h>
 #include <tf2_msgs/TFMessage.h>
 
 #include "cloud_io.h"
-#include "cube_scan_matcher/core/pose.h"
 #include "cube_scan_matcher/ros/cloud_conversion.h"
+#include "cube_scan_matcher/ros/transforms.h"
+#include "cube_scan_matcher/sim/motion.h"
 #include "dataset.h"
 #include "settings_cli.h"
 
@@ -36,17 +36,6 @@ const char* kUsage =
     "  --odometry-error T A add uniform errors of +-T [m] and +-A [deg] per parameter to each\n"
     "                       pose increment, so the matcher has to correct them (default 0 0)\n"
     "  --seed N             seed of those errors (default 1)\n";
-
-Eigen::Isometry3d readPose(std::istringstream& in, const std::string& where) {
-  double t[3], q[4];
-  if (!(in >> t[0] >> t[1] >> t[2] >> q[0] >> q[1] >> q[2] >> q[3])) {
-    throw std::runtime_error(where + ": expected tx ty tz qx qy qz qw");
-  }
-  Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
-  T.linear() = Eigen::Quaterniond(q[3], q[0], q[1], q[2]).normalized().toRotationMatrix();
-  T.translation() = Eigen::Vector3d(t[0], t[1], t[2]);
-  return T;
-}
 
 }  // namespace
 
@@ -112,7 +101,12 @@ int main(int argc, char** argv) {
       for (int n = 1; std::getline(in, line); ++n) {
         if (line.empty() || line[0] == '#') continue;
         std::istringstream ls(line);
-        poses.push_back(readPose(ls, poses_file + ":" + std::to_string(n)));
+        Eigen::Isometry3d T;
+        if (!tools::readPose(ls, T)) {
+          throw std::runtime_error(poses_file + ":" + std::to_string(n) +
+                                   ": expected tx ty tz qx qy qz qw");
+        }
+        poses.push_back(T);
       }
       if (poses.size() != clouds.size()) {
         throw std::runtime_error(poses_file + " has " + std::to_string(poses.size()) +
@@ -124,14 +118,10 @@ int main(int argc, char** argv) {
     // Odometry errors on each increment (the first pose stays exact).
     if (!poses.empty() && (err_t > 0.0 || err_a > 0.0)) {
       std::mt19937_64 rng(seed);
-      std::uniform_real_distribution<double> u(-1.0, 1.0);
       std::vector<Eigen::Isometry3d> noisy{poses[0]};
       for (std::size_t k = 1; k < poses.size(); ++k) {
-        Eigen::Isometry3d e = Eigen::Isometry3d::Identity();
-        e.translation() = err_t * Eigen::Vector3d(u(rng), u(rng), u(rng));
-        e.linear() = rotationFromRpy(deg2rad(err_a * u(rng)), deg2rad(err_a * u(rng)),
-                                     deg2rad(err_a * u(rng)));
-        noisy.push_back(noisy.back() * (poses[k - 1].inverse() * poses[k]) * e);
+        noisy.push_back(noisy.back() * (poses[k - 1].inverse() * poses[k]) *
+                        sim::randomTransform(rng, err_t, err_a));
       }
       poses = noisy;
     }
@@ -145,12 +135,8 @@ int main(int argc, char** argv) {
       header.frame_id = frame;
       header.seq = std::uint32_t(k);
       if (!poses.empty()) {
-        geometry_msgs::TransformStamped t = tf2::eigenToTransform(poses[k]);
-        t.header.stamp = stamp;
-        t.header.frame_id = odom_frame;
-        t.child_frame_id = frame;
         tf2_msgs::TFMessage tf;
-        tf.transforms.push_back(t);
+        tf.transforms.push_back(stampedTransform(poses[k], odom_frame, frame, stamp));
         bag.write("/tf", stamp - ros::Duration(0.001), tf);  // tf just before its cloud
       }
       bag.write("/" + topic, stamp, toCloud(pts, Eigen::Isometry3d::Identity(), header));

@@ -8,27 +8,6 @@
 namespace cube_scan_matcher {
 namespace {
 
-template <typename T>
-std::string str(T v) {
-  std::ostringstream os;
-  os << v;
-  return os.str();
-}
-
-/// Reads ~name (default `value`) and checks lo <= value <= hi.
-template <typename T>
-T get(const ros::NodeHandle& pnh, const std::string& name, T value, T lo, T hi,
-      const std::string& unit = "") {
-  if (pnh.hasParam(name) && !pnh.getParam(name, value)) {
-    throw ParamError("parameter ~" + name + " has the wrong type (expected a number)");
-  }
-  if (!(value >= lo && value <= hi)) {  // also false for NaN
-    throw ParamError("parameter ~" + name + " = " + str(value) + " is out of range [" + str(lo) +
-                     ", " + str(hi) + "]" + (unit.empty() ? "" : " " + unit));
-  }
-  return value;
-}
-
 std::string getString(const ros::NodeHandle& pnh, const std::string& name, std::string value) {
   if (pnh.hasParam(name) && !pnh.getParam(name, value)) {
     throw ParamError("parameter ~" + name + " must be a string");
@@ -99,53 +78,53 @@ NodeParams loadParams(const ros::NodeHandle& pnh) {
   if (p.map_frame == p.odom_frame || p.map_frame == p.base_frame) {
     throw ParamError("parameter ~map_frame must differ from ~odom_frame and ~base_frame");
   }
-  p.tf_timeout = get(pnh, "tf_timeout", p.tf_timeout, 0.0, 10.0, "s");
+  p.tf_timeout = readParam(pnh, "tf_timeout", p.tf_timeout, 0.0, 10.0, "s");
   const std::string policy = getString(pnh, "missing_tf_policy", "identity");
   if (policy != "identity" && policy != "skip") {
     throw ParamError("parameter ~missing_tf_policy = '" + policy + "' must be identity or skip");
   }
   p.skip_without_tf = policy == "skip";
   p.publish_tf = getBool(pnh, "publish_tf", p.publish_tf);
-  p.queue_size = get(pnh, "queue_size", p.queue_size, 1, 100);
-  p.path_max_length = get(pnh, "path_max_length", p.path_max_length, 1, 1000000);
-  p.filter.min_range = get(pnh, "min_range", p.filter.min_range, 0.0, 1e4, "m");
-  const double max_range = get(pnh, "max_range", 0.0, 0.0, 1e6, "m (0 = no limit)");
+  p.queue_size = readParam(pnh, "queue_size", p.queue_size, 1, 100);
+  p.path_max_length = readParam(pnh, "path_max_length", p.path_max_length, 1, 1000000);
+  p.filter.min_range = readParam(pnh, "min_range", p.filter.min_range, 0.0, 1e4, "m");
+  const double max_range = readParam(pnh, "max_range", 0.0, 0.0, 1e6, "m (0 = no limit)");
   p.filter.max_range = max_range > 0.0 ? max_range : 1e9;
   if (p.filter.max_range <= p.filter.min_range) {
     throw ParamError("parameter ~max_range must exceed ~min_range (or be 0 = no limit)");
   }
-  p.sigma_translation = get(pnh, "sigma_translation", p.sigma_translation, 1e-6, 100.0, "m");
-  p.sigma_rotation = get(pnh, "sigma_rotation", p.sigma_rotation, 1e-6, 180.0, "deg");
-  p.rejected_sigma_scale = get(pnh, "rejected_sigma_scale", p.rejected_sigma_scale, 1.0, 1e6);
-  p.min_rate = get(pnh, "min_rate", p.min_rate, 0.0, 1000.0, "Hz");
-  p.max_rate = get(pnh, "max_rate", p.max_rate, 0.0, 1e6, "Hz");
+  p.sigma_translation = readParam(pnh, "sigma_translation", p.sigma_translation, 1e-6, 100.0, "m");
+  p.sigma_rotation = readParam(pnh, "sigma_rotation", p.sigma_rotation, 1e-6, 180.0, "deg");
+  p.rejected_sigma_scale = readParam(pnh, "rejected_sigma_scale", p.rejected_sigma_scale, 1.0, 1e6);
+  p.min_rate = readParam(pnh, "min_rate", p.min_rate, 0.0, 1000.0, "Hz");
+  p.max_rate = readParam(pnh, "max_rate", p.max_rate, 0.0, 1e6, "Hz");
   if (p.max_rate <= p.min_rate) throw ParamError("parameter ~max_rate must exceed ~min_rate");
-  p.max_latency = get(pnh, "max_latency", p.max_latency, 1e-3, 1000.0, "s");
-  const double megabytes = get(pnh, "max_grid_megabytes", 256.0, 1.0, 65536.0, "MB");
+  p.max_latency = readParam(pnh, "max_latency", p.max_latency, 1e-3, 1000.0, "s");
+  const double megabytes = readParam(pnh, "max_grid_megabytes", 256.0, 1.0, 65536.0, "MB");
   p.matcher.registration.grid.max_cubes = std::uint64_t(megabytes * 8.0 * 1024.0 * 1024.0);
 
   // Live parameters: ranges as in cfg/ScanMatcher.cfg.
   ScanMatcherConfig c = toConfig(p);
-  c.cube_edge = get(pnh, "cube_edge", c.cube_edge, 0.05, 5.0, "m");
-  c.vertices = get(pnh, "vertices", c.vertices, 7, 1000);
-  c.iterations = get(pnh, "iterations", c.iterations, 1, 100000);
-  c.bounds_translation = get(pnh, "bounds_translation", c.bounds_translation, 0.01, 20.0, "m");
-  c.bounds_rotation = get(pnh, "bounds_rotation", c.bounds_rotation, 0.1, 90.0, "deg");
-  c.starts = get(pnh, "starts", c.starts, 1, 64);
-  c.threads = get(pnh, "threads", c.threads, 1, 64);
-  c.collapse_fraction = get(pnh, "collapse_fraction", c.collapse_fraction, 0.0, 1.0);
+  c.cube_edge = readParam(pnh, "cube_edge", c.cube_edge, 0.05, 5.0, "m");
+  c.vertices = readParam(pnh, "vertices", c.vertices, 7, 1000);
+  c.iterations = readParam(pnh, "iterations", c.iterations, 1, 100000);
+  c.bounds_translation = readParam(pnh, "bounds_translation", c.bounds_translation, 0.01, 20.0, "m");
+  c.bounds_rotation = readParam(pnh, "bounds_rotation", c.bounds_rotation, 0.1, 90.0, "deg");
+  c.starts = readParam(pnh, "starts", c.starts, 1, 64);
+  c.threads = readParam(pnh, "threads", c.threads, 1, 64);
+  c.collapse_fraction = readParam(pnh, "collapse_fraction", c.collapse_fraction, 0.0, 1.0);
   c.refine = getBool(pnh, "refine", c.refine);
-  c.refine_edge_fraction = get(pnh, "refine_edge_fraction", c.refine_edge_fraction, 0.05, 0.95);
-  c.refine_grids = get(pnh, "refine_grids", c.refine_grids, 1, 8);
-  c.seed = get(pnh, "seed", c.seed, 0, 2147483647);
-  c.min_overlap = get(pnh, "min_overlap", c.min_overlap, 0.0, 1.0);
-  c.min_j_gain = get(pnh, "min_j_gain", c.min_j_gain, 0, 1000000);
+  c.refine_edge_fraction = readParam(pnh, "refine_edge_fraction", c.refine_edge_fraction, 0.05, 0.95);
+  c.refine_grids = readParam(pnh, "refine_grids", c.refine_grids, 1, 8);
+  c.seed = readParam(pnh, "seed", c.seed, 0, 2147483647);
+  c.min_overlap = readParam(pnh, "min_overlap", c.min_overlap, 0.0, 1.0);
+  c.min_j_gain = readParam(pnh, "min_j_gain", c.min_j_gain, 0, 1000000);
   c.max_correction_translation =
-      get(pnh, "max_correction_translation", c.max_correction_translation, 0.01, 100.0, "m");
+      readParam(pnh, "max_correction_translation", c.max_correction_translation, 0.01, 100.0, "m");
   c.max_correction_rotation =
-      get(pnh, "max_correction_rotation", c.max_correction_rotation, 0.1, 180.0, "deg");
+      readParam(pnh, "max_correction_rotation", c.max_correction_rotation, 0.1, 180.0, "deg");
   c.max_consecutive_rejections =
-      get(pnh, "max_consecutive_rejections", c.max_consecutive_rejections, 1, 1000000);
+      readParam(pnh, "max_consecutive_rejections", c.max_consecutive_rejections, 1, 1000000);
   applyConfig(c, p);
   return p;
 }

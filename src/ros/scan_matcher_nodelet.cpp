@@ -166,7 +166,6 @@ void ScanMatcherNodelet::processCloud(const sensor_msgs::PointCloud2& msg, doubl
     status.dropped_scans = dropped_;
     status.consecutive_rejections = consecutive_rejections_;
     status.latency = ros::WallTime::now().toSec() - received;
-    last_latency_ = status.latency;
     latencies_.push_back(status.latency);
     if (latencies_.size() > 200) latencies_.pop_front();
     status_pub_.publish(status);

@@ -14,6 +14,7 @@
 #include <tf2_ros/transform_broadcaster.h>
 
 #include "cube_scan_matcher/ros/cloud_conversion.h"
+#include "cube_scan_matcher/ros/params.h"
 #include "cube_scan_matcher/ros/transforms.h"
 #include "cube_scan_matcher/sim/motion.h"
 #include "cube_scan_matcher/sim/tilting_scanner.h"
@@ -21,16 +22,6 @@
 using namespace cube_scan_matcher;
 
 namespace {
-
-template <typename T>
-T param(ros::NodeHandle& pnh, const std::string& name, T value, T lo, T hi) {
-  pnh.param(name, value, value);
-  if (!(value >= lo && value <= hi)) {
-    throw std::invalid_argument("parameter ~" + name + " is out of range [" + std::to_string(lo) +
-                                ", " + std::to_string(hi) + "]");
-  }
-  return value;
-}
 
 /// An organised cloud (height = 2D scans, width = beams per scan) with NaN for no return.
 sensor_msgs::PointCloud2 organised(const PointArray& pts, int width, int height,
@@ -56,23 +47,23 @@ int main(int argc, char** argv) {
     pnh.param<std::string>("base_frame", base_frame, "base_link");
     pnh.param<std::string>("scanner_frame", scanner_frame, "laser");
     pnh.param<std::string>("map_frame", map_frame, "map");
-    const int seed = param(pnh, "seed", 1, 0, 1 << 30);
-    const int sweeps = param(pnh, "sweeps", 0, 0, 1 << 30);  // 0 = until stopped
-    const double period = param(pnh, "period", 1.0, 0.05, 3600.0);
+    const int seed = readParam(pnh, "seed", 1, 0, 1 << 30);
+    const int sweeps = readParam(pnh, "sweeps", 0, 0, 1 << 30);  // 0 = until stopped
+    const double period = readParam(pnh, "period", 1.0, 0.05, 3600.0);
     const bool organized = pnh.param("organized", false);
     sim::ScannerModel model;
-    model.phi_step_deg = param(pnh, "phi_step", model.phi_step_deg, 0.05, 10.0);
-    model.psi_min_deg = param(pnh, "psi_min", model.psi_min_deg, -89.0, 89.0);
-    model.psi_max_deg = param(pnh, "psi_max", model.psi_max_deg, -89.0, 89.0);
-    model.psi_step_deg = param(pnh, "psi_step", model.psi_step_deg, 0.05, 10.0);
-    model.max_range = param(pnh, "max_range", model.max_range, 1.0, 1000.0);
-    model.range_noise = param(pnh, "range_noise", model.range_noise, 0.0, 1.0);
+    model.phi_step_deg = readParam(pnh, "phi_step", model.phi_step_deg, 0.05, 10.0);
+    model.psi_min_deg = readParam(pnh, "psi_min", model.psi_min_deg, -89.0, 89.0);
+    model.psi_max_deg = readParam(pnh, "psi_max", model.psi_max_deg, -89.0, 89.0);
+    model.psi_step_deg = readParam(pnh, "psi_step", model.psi_step_deg, 0.05, 10.0);
+    model.max_range = readParam(pnh, "max_range", model.max_range, 1.0, 1000.0);
+    model.range_noise = readParam(pnh, "range_noise", model.range_noise, 0.0, 1.0);
     sim::MotionSettings motion;
-    motion.step_min = param(pnh, "step_min", motion.step_min, 0.0, 20.0);
-    motion.step_max = param(pnh, "step_max", motion.step_max, motion.step_min, 20.0);
-    motion.yaw_change_max_deg = param(pnh, "yaw_change_max", motion.yaw_change_max_deg, 0.0, 90.0);
-    const double wait_for_subscriber = param(pnh, "wait_for_subscriber", 30.0, 0.0, 3600.0);
-    const double start_delay = param(pnh, "start_delay", 1.0, 0.0, 3600.0);
+    motion.step_min = readParam(pnh, "step_min", motion.step_min, 0.0, 20.0);
+    motion.step_max = readParam(pnh, "step_max", motion.step_max, motion.step_min, 20.0);
+    motion.yaw_change_max_deg = readParam(pnh, "yaw_change_max", motion.yaw_change_max_deg, 0.0, 90.0);
+    const double wait_for_subscriber = readParam(pnh, "wait_for_subscriber", 30.0, 0.0, 3600.0);
+    const double start_delay = readParam(pnh, "start_delay", 1.0, 0.0, 3600.0);
 
     const sim::Scene scene = sim::Scene::generate(sim::sceneTypeFromString(scene_name), std::uint64_t(seed));
     sim::RobotMotion robot(scene, motion, std::uint64_t(seed) + 1);

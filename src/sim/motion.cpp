@@ -13,6 +13,8 @@ double uniform(std::mt19937_64& rng, double half) {
   return std::uniform_real_distribution<double>(-half, half)(rng);
 }
 
+}  // namespace
+
 Eigen::Isometry3d randomTransform(std::mt19937_64& rng, double t, double a_deg) {
   Eigen::Isometry3d e = Eigen::Isometry3d::Identity();
   e.translation() = Eigen::Vector3d(uniform(rng, t), uniform(rng, t), uniform(rng, t));
@@ -20,8 +22,6 @@ Eigen::Isometry3d randomTransform(std::mt19937_64& rng, double t, double a_deg) 
                                deg2rad(uniform(rng, a_deg)));
   return e;
 }
-
-}  // namespace
 
 RobotMotion::RobotMotion(const Scene& scene, const MotionSettings& settings, std::uint64_t seed)
     : scene_(scene), s_(settings), rng_(seed) {

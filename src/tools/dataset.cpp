@@ -9,6 +9,17 @@
 
 namespace cube_scan_matcher::tools {
 
+bool readPose(std::istream& in, Eigen::Isometry3d& T, double* quaternion_norm) {
+  double t[3], q[4];
+  if (!(in >> t[0] >> t[1] >> t[2] >> q[0] >> q[1] >> q[2] >> q[3])) return false;
+  const Eigen::Quaterniond quat(q[3], q[0], q[1], q[2]);
+  if (quaternion_norm) *quaternion_norm = quat.norm();
+  T = Eigen::Isometry3d::Identity();
+  T.linear() = quat.normalized().toRotationMatrix();
+  T.translation() = Eigen::Vector3d(t[0], t[1], t[2]);
+  return true;
+}
+
 std::vector<PairEntry> readPairs(const std::string& dir) {
   const std::string file = dir + "/pairs.txt";
   std::ifstream in(file);
@@ -19,18 +30,15 @@ std::vector<PairEntry> readPairs(const std::string& dir) {
     if (line.find_first_not_of(" \t\r") == std::string::npos || line[0] == '#') continue;
     std::istringstream ls(line);
     PairEntry e;
-    double t[3], q[4];
-    if (!(ls >> e.source >> e.target >> t[0] >> t[1] >> t[2] >> q[0] >> q[1] >> q[2] >> q[3])) {
+    double norm = 1.0;
+    if (!(ls >> e.source >> e.target) || !readPose(ls, e.T_target_source, &norm)) {
       throw std::runtime_error(file + ":" + std::to_string(no) +
                                ": expected 'source target tx ty tz qx qy qz qw'");
     }
-    const Eigen::Quaterniond quat(q[3], q[0], q[1], q[2]);
-    if (std::abs(quat.norm() - 1.0) > 1e-3) {
+    if (std::abs(norm - 1.0) > 1e-3) {
       throw std::runtime_error(file + ":" + std::to_string(no) + ": quaternion is not unit");
     }
     e.name = e.source + "->" + e.target;
-    e.T_target_source.linear() = quat.normalized().toRotationMatrix();
-    e.T_target_source.translation() = Eigen::Vector3d(t[0], t[1], t[2]);
     e.source = dir + "/" + e.source;
     e.target = dir + "/" + e.target;
     pairs.push_back(e);

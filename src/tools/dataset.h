@@ -2,6 +2,7 @@
 //   source.pcd target.pcd tx ty tz qx qy qz qw      (T_target_source, metres, Hamilton)
 #pragma once
 
+#include <istream>
 #include <string>
 #include <vector>
 
@@ -15,6 +16,11 @@ struct PairEntry {
   Eigen::Isometry3d T_target_source = Eigen::Isometry3d::Identity();
   std::string name;    ///< "source->target" file names
 };
+
+/// Reads "tx ty tz qx qy qz qw" (metres, Hamilton quaternion) from `in` into T (the quaternion
+/// normalised). Returns false if the seven numbers are not there; `quaternion_norm`, if given,
+/// receives the norm before normalising.
+bool readPose(std::istream& in, Eigen::Isometry3d& T, double* quaternion_norm = nullptr);
 
 /// Reads DIR/pairs.txt. Throws std::runtime_error naming the file and line on bad input.
 std::vector<PairEntry> readPairs(const std::string& dir);

@@ -66,7 +66,6 @@ class ScanMatcherNodelet : public nodelet::Nodelet {
   std::optional<ros::Time> last_stamp_;
   std::uint32_t dropped_ = 0, rejected_ = 0, tf_failures_ = 0, processed_ = 0;
   std::uint32_t bad_input_ = 0, consecutive_rejections_ = 0;
-  double last_latency_ = 0.0;
   std::deque<double> latencies_;  // last latencies [s], for diagnostics
   bool initialised_ = false;
   std::string init_error_;

@@ -40,6 +40,10 @@ class RobotMotion {
   Eigen::Isometry3d pose_ = Eigen::Isometry3d::Identity();
 };
 
+/// A transform with uniform errors within +-t [m] on x, y, z and +-a_deg [deg] on roll, pitch,
+/// yaw (eq. 2): the odometry error of one increment.
+Eigen::Isometry3d randomTransform(std::mt19937_64& rng, double t, double a_deg);
+
 enum class OdometryError {
   None,   ///< odometry = truth
   Small,  ///< each increment off by uniform +-0.25 m, +-2 deg per parameter (paper "small")
