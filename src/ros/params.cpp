@@ -38,6 +38,8 @@ void configToSettings(const ScanMatcherConfig& c, OnlineMatcherSettings& m) {
   r.refine.enabled = c.refine;
   r.refine.edge_fraction = c.refine_edge_fraction;
   r.refine.grids = c.refine_grids;
+  r.refine.candidates = c.refine_candidates;
+  r.refine.coarse_weight = c.refine_coarse_weight;
   m.gate.min_overlap = c.min_overlap;
   m.gate.min_j_gain = c.min_j_gain;
   m.gate.max_correction_m = c.max_correction_translation;
@@ -62,6 +64,8 @@ ScanMatcherConfig toConfig(const NodeParams& p) {
   c.refine = r.refine.enabled;
   c.refine_edge_fraction = r.refine.edge_fraction;
   c.refine_grids = r.refine.grids;
+  c.refine_candidates = r.refine.candidates;
+  c.refine_coarse_weight = r.refine.coarse_weight;
   c.min_overlap = p.matcher.gate.min_overlap;
   c.min_j_gain = p.matcher.gate.min_j_gain;
   c.max_correction_translation = p.matcher.gate.max_correction_m;
@@ -116,6 +120,9 @@ NodeParams loadParams(const ros::NodeHandle& pnh) {
   c.refine = getBool(pnh, "refine", c.refine);
   c.refine_edge_fraction = readParam(pnh, "refine_edge_fraction", c.refine_edge_fraction, 0.05, 0.95);
   c.refine_grids = readParam(pnh, "refine_grids", c.refine_grids, 1, 8);
+  c.refine_candidates = readParam(pnh, "refine_candidates", c.refine_candidates, 1, 64);
+  c.refine_coarse_weight =
+      readParam(pnh, "refine_coarse_weight", c.refine_coarse_weight, 0.0, 100.0);
   c.seed = readParam(pnh, "seed", c.seed, 0, 2147483647);
   c.min_overlap = readParam(pnh, "min_overlap", c.min_overlap, 0.0, 1.0);
   c.min_j_gain = readParam(pnh, "min_j_gain", c.min_j_gain, 0, 1000000);

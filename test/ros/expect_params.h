@@ -19,6 +19,8 @@ inline void expectSameLiveParams(const ScanMatcherConfig& a, const ScanMatcherCo
   EXPECT_EQ(a.refine, b.refine);
   EXPECT_DOUBLE_EQ(a.refine_edge_fraction, b.refine_edge_fraction);
   EXPECT_EQ(a.refine_grids, b.refine_grids);
+  EXPECT_EQ(a.refine_candidates, b.refine_candidates);
+  EXPECT_DOUBLE_EQ(a.refine_coarse_weight, b.refine_coarse_weight);
   EXPECT_EQ(a.seed, b.seed);
   EXPECT_DOUBLE_EQ(a.min_overlap, b.min_overlap);
   EXPECT_EQ(a.min_j_gain, b.min_j_gain);
