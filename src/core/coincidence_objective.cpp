@@ -4,29 +4,109 @@
 
 namespace cube_scan_matcher {
 
+CoincidenceObjective::CoincidenceObjective(const CubeGrid& grid) : grid_(&grid), idx_(kBlock) {
+  initWorkingCopy();
+}
+
+void CoincidenceObjective::initWorkingCopy() {
+  // The working copy is all zero on entry (new, or cleared by setGrid), so only growth is
+  // written: 1 for each set cube of L, and a spare always-zero cube past the grid into which
+  // outside points index.
+  const CubeGrid& grid = *grid_;
+  if (grid.bytePerCube()) {
+    std::vector<std::uint64_t>().swap(bits_);
+    outside_ = std::int32_t(grid.cubeCount());
+    bytes_.resize(std::size_t(grid.cubeCount()) + 1, 0);
+    for (std::int32_t c : grid.list()) bytes_[std::size_t(c)] = 1;
+  } else {
+    std::vector<std::uint8_t>().swap(bytes_);
+    const std::size_t words = grid.bits().size();
+    outside_ = std::int32_t(words * 64);
+    bits_.resize(words + 1, 0);
+    for (std::int32_t c : grid.list()) bits_[std::size_t(c) >> 6] |= std::uint64_t{1} << (c & 63);
+  }
+}
+
+void CoincidenceObjective::setGrid(const CubeGrid& grid) {
+  // Between evaluations the working copy equals the old V: clearing the old L zeroes it.
+  for (std::int32_t c : grid_->list()) {
+    if (bytePerCube()) {
+      bytes_[std::size_t(c)] = 0;
+    } else {
+      bits_[std::size_t(c) >> 6] = 0;
+    }
+  }
+  grid_ = &grid;
+  scan_ = nullptr;
+  initWorkingCopy();
+}
+
 CoincidenceObjective::CoincidenceObjective(const CubeGrid& grid, const PointArray& scan)
-    : grid_(grid), scan_(scan), work_(grid.bits()), idx_(kBlock) {
-  // One spare word past V, always zero: outside points index into it and never count.
-  outside_ = std::int32_t(work_.size() * 64);
-  work_.push_back(0);
-  // The counting loop stores every index and advances only on a hit: room for n + 1 stores.
-  hits_.resize(scan.size() + 1);
+    : CoincidenceObjective(grid) {
+  setScan(scan);
+}
+
+void CoincidenceObjective::setScan(const PointArray& scan) {
+  scan_ = &scan;
+  // The bit-mode counting loop stores every index and advances only on a hit: n + 1 stores.
+  if (!bytePerCube() && hits_.size() < scan.size() + 1) hits_.resize(scan.size() + 1);
+}
+
+bool CoincidenceObjective::workingCopyRestored() const {
+  if (bytePerCube()) {
+    std::size_t set = 0;
+    for (std::size_t c = 0; c < bytes_.size(); ++c) {
+      if (bytes_[c] > 1 || (bytes_[c] && !grid_->occupied(std::int64_t(c)))) return false;
+      set += bytes_[c];
+    }
+    return set == grid_->occupiedCount() && bytes_.back() == 0;
+  }
+  return std::equal(grid_->bits().begin(), grid_->bits().end(), bits_.begin()) &&
+         bits_.back() == 0;
 }
 
 int CoincidenceObjective::evaluate(const Pose6& pose) {
   ++evaluations_;
+  if (!scan_ || scan_->empty()) return 0;
   const Eigen::Isometry3d t = poseToIsometry(pose);
-  const GridAffine g =
-      grid_.affine(t.linear().cast<float>(), t.translation().cast<float>());
-  const Eigen::Vector3f& dims = grid_.dimsF();
-  std::uint64_t* const v = work_.data();
-  std::int32_t* const hits = hits_.data();
+  const GridAffine g = grid_->affine(t.linear().cast<float>(), t.translation().cast<float>());
+  return bytePerCube() ? countBytes(g) : countBits(g);
+}
+
+int CoincidenceObjective::countBytes(const GridAffine& g) {
+  const Eigen::Vector3f& dims = grid_->dimsF();
+  std::uint8_t* const v = bytes_.data();
+  const PointArray& scan = *scan_;
   int j = 0;
-  const std::size_t n = scan_.size();
-  for (std::size_t begin = 0; begin < n; begin += kBlock) {
-    const std::size_t m = std::min(kBlock, n - begin);
-    computeCubeIndices(g, dims, scan_.x.data() + begin, scan_.y.data() + begin,
-                       scan_.z.data() + begin, m, outside_, idx_.data());
+  for (std::size_t begin = 0; begin < scan.size(); begin += kBlock) {
+    const std::size_t m = std::min(kBlock, scan.size() - begin);
+    computeCubeIndices(g, dims, scan.x.data() + begin, scan.y.data() + begin,
+                       scan.z.data() + begin, m, outside_, idx_.data());
+    // A set cube hit for the first time counts 1 and is cleared; a clear cube, a cube already
+    // hit and the spare outside cube count 0. The store does not depend on the load, so
+    // consecutive points in the same cube do not wait on each other.
+    const std::int32_t* id = idx_.data();
+    for (std::size_t i = 0; i < m; ++i) {
+      std::uint8_t& cube = v[std::uint32_t(id[i])];
+      j += cube;
+      cube = 0;
+    }
+  }
+  // Restore from L (the paper's way, l stores): cheaper than recording the J hits in the loop.
+  for (std::int32_t c : grid_->list()) v[std::size_t(c)] = 1;
+  return j;
+}
+
+int CoincidenceObjective::countBits(const GridAffine& g) {
+  const Eigen::Vector3f& dims = grid_->dimsF();
+  std::uint64_t* const v = bits_.data();
+  std::int32_t* const hits = hits_.data();
+  const PointArray& scan = *scan_;
+  int j = 0;
+  for (std::size_t begin = 0; begin < scan.size(); begin += kBlock) {
+    const std::size_t m = std::min(kBlock, scan.size() - begin);
+    computeCubeIndices(g, dims, scan.x.data() + begin, scan.y.data() + begin,
+                       scan.z.data() + begin, m, outside_, idx_.data());
     // Branch-free: a set cube hit for the first time is counted and cleared; a clear cube,
     // a cube already hit, and the spare outside cube change nothing. Consecutive scan points
     // mostly hit the same word of V, so one stream would wait on its own store at every point;

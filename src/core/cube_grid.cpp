@@ -16,6 +16,10 @@ void validate(const CubeGridSettings& s) {
     throw std::invalid_argument("max_cubes must be in [1, 2^31], got " +
                                 std::to_string(s.max_cubes));
   }
+  if (s.max_byte_cubes > (std::uint64_t{1} << 28)) {
+    throw std::invalid_argument("max_byte_cubes must be in [0, 2^28], got " +
+                                std::to_string(s.max_byte_cubes));
+  }
   if (!(s.origin_shift >= 0.0 && s.origin_shift < 1.0)) {
     throw std::invalid_argument("origin_shift must be in [0, 1), got " +
                                 std::to_string(s.origin_shift));
@@ -79,6 +83,7 @@ CubeGrid CubeGrid::build(const PointArray& ref, const CubeGridSettings& settings
   }
   CubeGrid g;
   g.edge_ = settings.cube_edge;
+  g.max_byte_cubes_ = settings.max_byte_cubes;
   Eigen::Vector3d lo = Eigen::Vector3d::Constant(std::numeric_limits<double>::infinity());
   Eigen::Vector3d hi = -lo;
   for (std::size_t i = 0; i < ref.size(); ++i) {

@@ -3,7 +3,7 @@
 #include <algorithm>
 #include <chrono>
 #include <memory>
-#include <optional>
+#include <mutex>
 #include <sstream>
 #include <thread>
 #include <stdexcept>
@@ -54,6 +54,7 @@ void validate(const RegistrationSettings& s) {
     requireInRange("refine coarse_weight", s.refine.coarse_weight, 0.0, 100.0);
     requireInRange("refine candidates", s.refine.candidates, 1, 64);
     requireInRange("refine grids", s.refine.grids, 1, 8);
+    requireInRange("refine coarse_grids", s.refine.coarse_grids, 1, 8);
     requireInRange("refine collapse_fraction", s.refine.collapse_fraction, 0.0, 1.0);
   }
   requireInRange("search starts", s.search.starts, 1, 64);
@@ -77,76 +78,168 @@ std::string toString(RegistrationStatus status) {
   return "unknown";
 }
 
-CubeRegistration::CubeRegistration(const RegistrationSettings& settings) : settings_(settings) {
+// The grids of one reference scan, built together in setReference().
+struct CubeRegistration::Reference {
+  CubeGrid grid;                   // edge E: the coarse stage (and the refine's coarse term)
+  std::vector<CubeGrid> fine;      // edge edge_fraction * E, shifted: the refine stage
+  std::vector<CubeGrid> shifted;   // edge E, shifted: more of the refine's coarse term
+};
+
+// One thread's objectives: a working copy of every grid, kept from one align() to the next
+// (and retargeted, not reallocated, when the reference changes).
+struct CubeRegistration::Workspace {
+  explicit Workspace(const Reference& r) : coarse(r.grid) { retarget(r); }
+
+  void retarget(const Reference& r) {
+    if (target != &r) coarse.setGrid(r.grid);
+    retargetAll(fine, r.fine);
+    retargetAll(shifted, r.shifted);
+    target = &r;
+  }
+
+  CoincidenceObjective coarse;
+  std::vector<CoincidenceObjective> fine, shifted;
+  const Reference* target = nullptr;
+
+ private:
+  static void retargetAll(std::vector<CoincidenceObjective>& objectives,
+                          const std::vector<CubeGrid>& grids) {
+    if (objectives.size() > grids.size()) {
+      objectives.erase(objectives.begin() + std::ptrdiff_t(grids.size()), objectives.end());
+    }
+    for (std::size_t k = 0; k < objectives.size(); ++k) objectives[k].setGrid(grids[k]);
+    for (std::size_t k = objectives.size(); k < grids.size(); ++k) {
+      objectives.emplace_back(grids[k]);
+    }
+  }
+};
+
+namespace {
+
+/// Runs job(k) for k = 0..count-1 on `threads` threads (the caller's thread is thread 0):
+/// job k runs on thread k % threads, so thread t always uses workspace t.
+template <typename Job>
+void runOnThreads(int count, int threads, const Job& job) {
+  threads = std::max(1, std::min(threads, count));
+  auto worker = [&](int t) {
+    for (int k = t; k < count; k += threads) job(k, t);
+  };
+  std::vector<std::thread> pool;
+  for (int t = 1; t < threads; ++t) pool.emplace_back(worker, t);
+  worker(0);
+  for (std::thread& t : pool) t.join();
+}
+
+/// The centroid of the points [m] (double sums).
+Eigen::Vector3d centroid(const PointArray& p) {
+  Eigen::Vector3d c = Eigen::Vector3d::Zero();
+  for (std::size_t i = 0; i < p.size(); ++i) c += Eigen::Vector3d(p.x[i], p.y[i], p.z[i]);
+  return p.empty() ? c : Eigen::Vector3d(c / double(p.size()));
+}
+
+}  // namespace
+
+CubeRegistration::CubeRegistration(const RegistrationSettings& settings)
+    : settings_(settings), mutex_(std::make_unique<std::mutex>()) {
   validate(settings_);
 }
 
+CubeRegistration::~CubeRegistration() = default;
+CubeRegistration::CubeRegistration(CubeRegistration&&) noexcept = default;
+CubeRegistration& CubeRegistration::operator=(CubeRegistration&&) noexcept = default;
+
 void CubeRegistration::setSettings(const RegistrationSettings& settings) {
   validate(settings);
+  std::lock_guard<std::mutex> lock(*mutex_);
   settings_ = settings;
 }
 
+bool CubeRegistration::hasReference() const { return reference_ != nullptr; }
+
+const CubeGrid& CubeRegistration::grid() const {
+  static const CubeGrid empty;
+  return reference_ ? reference_->grid : empty;
+}
+
+const std::vector<CubeGrid>& CubeRegistration::fineGrids() const {
+  static const std::vector<CubeGrid> none;
+  return reference_ ? reference_->fine : none;
+}
+
+const std::vector<CubeGrid>& CubeRegistration::shiftedCoarseGrids() const {
+  static const std::vector<CubeGrid> none;
+  return reference_ ? reference_->shifted : none;
+}
+
 void CubeRegistration::setReference(const PointArray& reference) {
-  // Both grids are built before either is replaced, so an error keeps the previous reference.
-  CubeGrid coarse = CubeGrid::build(reference, settings_.grid);
-  std::vector<CubeGrid> fine;
+  // All grids are built before any is replaced, so an error keeps the previous reference.
+  auto next = std::make_unique<Reference>();
+  next->grid = CubeGrid::build(reference, settings_.grid);
   if (settings_.refine.enabled) {
     CubeGridSettings gs = settings_.grid;
+    for (int k = 1; k < settings_.refine.coarse_grids && settings_.refine.coarse_weight > 0.0;
+         ++k) {
+      gs.origin_shift = double(k) / settings_.refine.coarse_grids;
+      next->shifted.push_back(CubeGrid::build(reference, gs));
+    }
     gs.cube_edge *= settings_.refine.edge_fraction;
     for (int k = 0; k < settings_.refine.grids; ++k) {
       gs.origin_shift = double(k) / settings_.refine.grids;
-      fine.push_back(CubeGrid::build(reference, gs));
+      next->fine.push_back(CubeGrid::build(reference, gs));
     }
   }
-  grid_ = std::move(coarse);
-  fine_grids_ = std::move(fine);
-  has_reference_ = true;
+  std::lock_guard<std::mutex> lock(*mutex_);
+  // The working copies move to the new grids while the old ones are still alive.
+  for (auto& w : workspaces_) w->retarget(*next);
+  reference_ = std::move(next);
+}
+
+void CubeRegistration::prepareWorkspaces(int count) const {
+  for (auto& w : workspaces_) w->retarget(*reference_);  // no-op when already on it
+  while (int(workspaces_.size()) < count) {
+    workspaces_.push_back(std::make_unique<Workspace>(*reference_));
+  }
 }
 
 const PointArray& CubeRegistration::prepareScan(const PointArray& scan, PointArray& storage,
                                                double fraction) const {
   if (fraction <= 0.0) return scan;
-  storage = collapseToVoxels(scan, fraction * grid_.edge());
+  storage = collapseToVoxels(scan, fraction * reference_->grid.edge());
   return storage;
 }
 
 int CubeRegistration::score(const PointArray& scan, const Pose6& pose) const {
-  if (!has_reference_) throw std::logic_error("CubeRegistration::score before setReference");
+  if (!reference_) throw std::logic_error("CubeRegistration::score before setReference");
   if (scan.empty()) return 0;
+  std::lock_guard<std::mutex> lock(*mutex_);
+  prepareWorkspaces(1);
   PointArray storage;
-  CoincidenceObjective objective(grid_, prepareScan(scan, storage, settings_.collapse_fraction));
-  return objective(pose);
+  CoincidenceObjective& objective = workspaces_[0]->coarse;
+  objective.setScan(prepareScan(scan, storage, settings_.collapse_fraction));
+  const int j = objective(pose);
+  objective.setScan(PointArray::empty_array());
+  return j;
 }
 
-GnmmResult CubeRegistration::coarseSearch(const PointArray& points, const Pose6& guess,
-                                          CoincidenceObjective& objective,
+GnmmResult CubeRegistration::coarseSearch(const Pose6& guess,
                                           std::vector<Vector6d>* candidates) const {
   const SearchSettings& ss = settings_.search;
   // Independent starts (seeds seed + k) in rounds of `threads` starts, one per thread, each
-  // thread with its own objective (its own working copy of V). After each round, stop once
-  // `consensus` finished starts agree with the best one (the basin is found).
+  // on its thread's working copy of V. After each round, stop once `consensus` finished
+  // starts agree with the best one (the basin is found).
   const int threads = std::min(ss.threads, ss.starts);
-  std::vector<std::unique_ptr<CoincidenceObjective>> objectives;
-  for (int t = 1; t < threads; ++t) {
-    objectives.push_back(std::make_unique<CoincidenceObjective>(grid_, points));
-  }
   std::vector<GnmmResult> runs;
   runs.reserve(std::size_t(ss.starts));
-  auto run = [&](int k, CoincidenceObjective& f, GnmmResult& out) {
-    GnmmSettings gs = settings_.gnmm;
-    gs.seed += std::uint64_t(k);
-    out = Gnmm(gs).maximize([&f](const Vector6d& p) { return double(f(p)); }, guess);
-  };
   while (int(runs.size()) < ss.starts) {
     const int first = int(runs.size()), count = std::min(threads, ss.starts - first);
     runs.resize(std::size_t(first + count));
-    std::vector<std::thread> pool;
-    for (int t = 1; t < count; ++t) {
-      pool.emplace_back(run, first + t, std::ref(*objectives[std::size_t(t - 1)]),
-                        std::ref(runs[std::size_t(first + t)]));
-    }
-    run(first, objective, runs[std::size_t(first)]);
-    for (std::thread& t : pool) t.join();
+    runOnThreads(count, threads, [&](int k, int t) {
+      CoincidenceObjective& f = workspaces_[std::size_t(t)]->coarse;
+      GnmmSettings gs = settings_.gnmm;
+      gs.seed += std::uint64_t(first + k);
+      runs[std::size_t(first + k)] =
+          Gnmm(gs).maximize([&f](const Vector6d& p) { return double(f(p)); }, guess);
+    });
     if (ss.consensus > 0) {
       const GnmmResult& top = *std::max_element(
           runs.begin(), runs.end(),
@@ -183,6 +276,7 @@ GnmmResult CubeRegistration::coarseSearch(const PointArray& points, const Pose6&
   best.initial_value = runs[0].initial_value;
 
   // Polish: GNMM around the best pose so far with the bounds halved at each run.
+  CoincidenceObjective& objective = workspaces_[0]->coarse;
   GnmmSettings gs = settings_.gnmm;
   gs.max_iterations = ss.polish_iterations;
   for (int run = 0; run < ss.polish_runs; ++run) {
@@ -204,6 +298,59 @@ GnmmResult CubeRegistration::coarseSearch(const PointArray& points, const Pose6&
   return best;
 }
 
+void CubeRegistration::refine(const PointArray& points, std::vector<Vector6d> candidates,
+                              RegistrationResult& res) const {
+  const RefineSettings& rs = settings_.refine;
+  // Multi-scale objective: the sum of J over the fine grids plus coarse_weight times J over
+  // the E grids, so the refine stage cannot trade coarse-level agreement for a fine-level
+  // near-tie.
+  const double w = rs.coarse_weight;
+  // Rotation pivot c: the refine variable is q = [R c + t, roll, pitch, yaw], so a rotation
+  // step turns the points about c (pose: t = q_xyz - R c).
+  const Eigen::Vector3d c = rs.centroid_pivot ? centroid(points) : Eigen::Vector3d::Zero();
+  auto toPose = [&c](const Vector6d& q) {
+    Pose6 p = q;
+    p.head<3>() = q.head<3>() - poseToIsometry(q).linear() * c;
+    return p;
+  };
+  auto toQ = [&c](const Pose6& p) {
+    Vector6d q = p;
+    q.head<3>() = poseToIsometry(p) * c;
+    return q;
+  };
+  // The best `candidates` distinct coarse results (the winner first), one per thread; the
+  // highest fine value wins (the finer cubes settle near-ties of the coarse J).
+  candidates.resize(std::min(candidates.size(), std::size_t(rs.candidates)));
+  if (candidates.empty()) candidates.push_back(res.pose);
+  std::vector<CompassResult> results(candidates.size());
+  runOnThreads(int(candidates.size()), settings_.search.threads, [&](int k, int t) {
+    Workspace& ws = *workspaces_[std::size_t(t)];
+    for (CoincidenceObjective& j : ws.fine) j.setScan(points);
+    for (CoincidenceObjective& j : ws.shifted) j.setScan(points);
+    ws.coarse.setScan(points);
+    auto value = [&ws, &toPose, w](const Vector6d& q) {
+      const Pose6 p = toPose(q);
+      int sum = 0, coarse_sum = 0;
+      for (CoincidenceObjective& j : ws.fine) sum += j(p);
+      if (w > 0.0) {
+        coarse_sum = ws.coarse(p);
+        for (CoincidenceObjective& j : ws.shifted) coarse_sum += j(p);
+      }
+      return double(sum) + w * double(coarse_sum);
+    };
+    results[std::size_t(k)] = compassMaximize(value, toQ(candidates[std::size_t(k)]), rs.compass);
+  });
+  double best = -1.0;
+  for (const CompassResult& r : results) {
+    res.evaluations += r.evaluations;
+    res.evaluations_refine += r.evaluations;
+    if (r.best_value > best) {
+      best = r.best_value;
+      res.pose = toPose(r.best);
+    }
+  }
+}
+
 RegistrationResult CubeRegistration::align(const PointArray& scan, const Pose6& guess) const {
   const auto start = std::chrono::steady_clock::now();
   RegistrationResult res;
@@ -216,17 +363,28 @@ RegistrationResult CubeRegistration::align(const PointArray& scan, const Pose6& 
     res.time_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     return res;
   };
-  if (!has_reference_) return finish(RegistrationStatus::NoReference, "no reference scan set");
-  res.reference_cubes = grid_.occupiedCount();
+  if (!reference_) return finish(RegistrationStatus::NoReference, "no reference scan set");
+  res.reference_cubes = reference_->grid.occupiedCount();
   if (scan.empty()) return finish(RegistrationStatus::EmptyScan, "scan has no valid point");
+
+  std::lock_guard<std::mutex> lock(*mutex_);
+  const SearchSettings& ss = settings_.search;
+  const int threads = std::max(std::min(ss.threads, ss.starts),
+                               settings_.refine.enabled
+                                   ? std::min(ss.threads, settings_.refine.candidates)
+                                   : 1);
+  prepareWorkspaces(threads);
 
   PointArray storage;
   const PointArray* points = &prepareScan(scan, storage, settings_.collapse_fraction);
   res.points_used = points->size();
+  for (auto& w : workspaces_) w->coarse.setScan(*points);
 
-  CoincidenceObjective objective(grid_, *points);
   std::vector<Vector6d> candidates;
-  const GnmmResult g = coarseSearch(*points, guess, objective, &candidates);
+  const auto coarse_start = std::chrono::steady_clock::now();
+  const GnmmResult g = coarseSearch(guess, &candidates);
+  const auto coarse_end = std::chrono::steady_clock::now();
+  res.time_coarse_s = std::chrono::duration<double>(coarse_end - coarse_start).count();
   res.pose = g.best;
   res.J = res.J_coarse = int(g.best_value);
   res.J_guess = int(g.initial_value);
@@ -236,41 +394,25 @@ RegistrationResult CubeRegistration::align(const PointArray& scan, const Pose6& 
   res.stop = g.stop;
 
   // Refine stage (not in the paper): compass search on the fine grids from the coarse
-  // result, maximising the sum of their J, on the scan collapsed at its own (finer) voxel; the
-  // default, E/4, is half a fine cube.
-  if (settings_.refine.enabled && res.J > 0 && !fine_grids_.empty()) {
+  // results, on the scan collapsed at its own voxel; the default, E/4, is half a fine cube.
+  if (settings_.refine.enabled && res.J > 0 && !reference_->fine.empty()) {
     PointArray fine_storage;
     const PointArray& fine_points =
         settings_.refine.collapse_fraction == settings_.collapse_fraction
             ? *points
             : prepareScan(scan, fine_storage, settings_.refine.collapse_fraction);
-    std::vector<CoincidenceObjective> fine;
-    fine.reserve(fine_grids_.size());
-    for (const CubeGrid& grid : fine_grids_) fine.emplace_back(grid, fine_points);
-    // Multi-scale: the coarse cubes (weighted) join the fine grids' sum, so the refine stage
-    // cannot trade coarse-level agreement for a fine-level near-tie.
-    const double w = settings_.refine.coarse_weight;
-    std::optional<CoincidenceObjective> coarse_on_fine;
-    if (w > 0.0) coarse_on_fine.emplace(grid_, fine_points);
-    auto fine_j = [&fine, &coarse_on_fine, w](const Vector6d& p) {
-      int sum = 0;
-      for (CoincidenceObjective& j : fine) sum += j(p);
-      return double(sum) + (coarse_on_fine ? w * (*coarse_on_fine)(p) : 0.0);
-    };
-    // Refine the best `candidates` distinct coarse results (the winner first) and keep the
-    // highest fine J: the finer cubes settle near-ties of the coarse J.
-    candidates.resize(std::min(candidates.size(), std::size_t(settings_.refine.candidates)));
-    if (candidates.empty()) candidates.push_back(res.pose);
-    double best_fine = -1.0;
-    for (const Vector6d& start : candidates) {
-      const CompassResult c = compassMaximize(fine_j, start, settings_.refine.compass);
-      res.evaluations += c.evaluations;
-      if (c.best_value > best_fine) {
-        best_fine = c.best_value;
-        res.pose = c.best;
-      }
-    }
+    refine(fine_points, std::move(candidates), res);
+    CoincidenceObjective& objective = workspaces_[0]->coarse;
+    objective.setScan(*points);
     res.J = objective(res.pose);
+    res.time_refine_s =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - coarse_end).count();
+  }
+  // No objective keeps a pointer to this call's points.
+  for (auto& w : workspaces_) {
+    w->coarse.setScan(PointArray::empty_array());
+    for (CoincidenceObjective& j : w->fine) j.setScan(PointArray::empty_array());
+    for (CoincidenceObjective& j : w->shifted) j.setScan(PointArray::empty_array());
   }
   for (int k = 3; k < 6; ++k) res.pose[k] = wrapAngle(res.pose[k]);
   res.transform = poseToIsometry(res.pose);

@@ -44,6 +44,8 @@ std::string algorithmOptionsHelp() {
          "                        (default " + std::to_string(d.refine.candidates) + ")\n"
          "  --refine-collapse F   the refine stage evaluates one point per voxel of F*E\n"
          "                        (default " + num(d.refine.collapse_fraction) + ")\n"
+         "  --refine-coarse-grids K  the coarse term sums J over K grids of edge E shifted by\n"
+         "                        1/K cube (default " + std::to_string(d.refine.coarse_grids) + ")\n"
          "  --refine-grids K      refine on the sum of J over K fine grids shifted by 1/K cube\n"
          "                        (anti-aliasing; default " + std::to_string(d.refine.grids) + ")\n"
          "  --refine-levels N     compass-search step halvings in the refine stage (default " + std::to_string(d.refine.compass.levels) + ")\n"
@@ -97,6 +99,8 @@ bool parseAlgorithmOption(const std::vector<std::string>& args, std::size_t& i,
     s.refine.candidates = int(value(1)), used = 2;
   } else if (a == "--refine-collapse") {
     s.refine.collapse_fraction = value(1), used = 2;
+  } else if (a == "--refine-coarse-grids") {
+    s.refine.coarse_grids = int(value(1)), used = 2;
   } else if (a == "--refine-grids") {
     s.refine.grids = int(value(1)), used = 2;
   } else if (a == "--refine-levels") {

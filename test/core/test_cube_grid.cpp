@@ -1,5 +1,7 @@
 #include <gtest/gtest.h>
 
+#include <cmath>
+
 #include "cube_scan_matcher/core/coincidence_objective.h"
 #include "cube_scan_matcher/core/cube_grid.h"
 
@@ -162,5 +164,60 @@ TEST(CubeGrid, SettingsOutOfRangeAreRefusedByName) {
     FAIL();
   } catch (const std::invalid_argument& e) {
     EXPECT_NE(std::string(e.what()).find("max_cubes"), std::string::npos);
+  }
+}
+
+namespace {
+PointArray wavySurface(int n, float phase) {
+  PointArray p;
+  for (int i = 0; i < n; ++i) {
+    p.push_back(float(std::sin(i * 0.37 + phase) * 9), float(std::cos(i * 0.11) * 7),
+                float((i % 13) * 0.31));
+  }
+  return p;
+}
+}  // namespace
+
+TEST(CoincidenceObjective, BytePerCubeAndBitPerCubeGiveTheSameJ) {
+  const PointArray p = wavySurface(3000, 0.f);
+  CubeGridSettings bytes = edge(0.5), bits = edge(0.5);
+  bits.max_byte_cubes = 0;  // force the bit working copy
+  const CubeGrid gb = CubeGrid::build(p, bytes), gv = CubeGrid::build(p, bits);
+  CoincidenceObjective jb(gb, p), jv(gv, p);
+  ASSERT_TRUE(jb.bytePerCube());
+  ASSERT_FALSE(jv.bytePerCube());
+  for (int k = 0; k < 40; ++k) {
+    Pose6 pose;
+    pose << 0.07 * k, -0.05 * k, 0.02 * k, 0.01 * k, -0.02 * k, 0.03 * k;
+    EXPECT_EQ(jb(pose), jv(pose)) << k;
+    EXPECT_TRUE(jb.workingCopyRestored());
+    EXPECT_TRUE(jv.workingCopyRestored());
+  }
+}
+
+TEST(CoincidenceObjective, SetGridGivesTheSameJAsAFreshObjective) {
+  // Retargeting reuses the working copy (byte or bit) across grids of different sizes; J and
+  // the restored copy must be those of an objective built on the new grid.
+  const PointArray a = wavySurface(3000, 0.f), b = wavySurface(2500, 1.3f);
+  for (std::uint64_t max_bytes : {std::uint64_t{0}, std::uint64_t{1} << 22}) {
+    CubeGridSettings s = edge(0.5);
+    s.max_byte_cubes = max_bytes;
+    const CubeGrid ga = CubeGrid::build(a, s);
+    CubeGridSettings fine = s;
+    fine.cube_edge = 0.2;
+    const CubeGrid gb = CubeGrid::build(b, fine);
+    CoincidenceObjective moving(ga, a);
+    EXPECT_EQ(moving(Pose6::Zero()), int(ga.occupiedCount()));
+    moving.setGrid(gb);
+    EXPECT_TRUE(moving.workingCopyRestored());
+    EXPECT_EQ(moving(Pose6::Zero()), 0);  // no scan bound after setGrid
+    moving.setScan(a);
+    CoincidenceObjective fresh(gb, a);
+    for (double dx : {0.0, 0.1, -0.4, 1.0}) EXPECT_EQ(moving(shift(dx)), fresh(shift(dx))) << dx;
+    moving.setGrid(ga);  // and back to the smaller grid
+    moving.setScan(b);
+    CoincidenceObjective back(ga, b);
+    EXPECT_EQ(moving(shift(0.3)), back(shift(0.3)));
+    EXPECT_TRUE(moving.workingCopyRestored());
   }
 }

@@ -149,6 +149,30 @@ TEST(Registration, FailedReferenceKeepsThePreviousOne) {
   EXPECT_EQ(reg.grid().occupiedCount(), l);
 }
 
+TEST(Registration, AReusedMatcherGivesTheResultsOfAFreshOne) {
+  // The per-thread working copies outlive a reference: a matcher that has registered other
+  // scans (other grid sizes) must give exactly what a fresh matcher gives.
+  const Scans a = makeScans(sim::SceneType::Urban, 3), b = makeScans(sim::SceneType::Park, 4);
+  Pose6 guess_a = isometryToPose(a.T_first_second), guess_b = isometryToPose(b.T_first_second);
+  guess_a[0] += 0.4;
+  guess_b[5] += deg2rad(3);
+  CubeRegistration reused(defaultSettings());
+  reused.setReference(b.first);
+  const RegistrationResult rb = reused.align(b.second, guess_b);
+  reused.setReference(a.first);
+  const RegistrationResult ra = reused.align(a.second, guess_a);
+  for (int k = 0; k < 2; ++k) {
+    CubeRegistration fresh(defaultSettings());
+    fresh.setReference(k ? b.first : a.first);
+    const RegistrationResult f = fresh.align(k ? b.second : a.second, k ? guess_b : guess_a);
+    const RegistrationResult& r = k ? rb : ra;
+    EXPECT_EQ(r.J, f.J) << k;
+    EXPECT_EQ(r.evaluations, f.evaluations) << k;
+    EXPECT_TRUE(r.pose.isApprox(f.pose, 1e-12)) << k;
+  }
+  EXPECT_EQ(reused.score(a.second, ra.pose), ra.J);
+}
+
 TEST(Registration, SettingsAreValidated) {
   RegistrationSettings s = defaultSettings();
   s.collapse_fraction = 2.0;

@@ -2,7 +2,6 @@
 // least one scan point falls into, for a candidate pose. It knows nothing about the optimizer.
 #pragma once
 
-#include <algorithm>
 #include <cstdint>
 #include <vector>
 
@@ -14,32 +13,47 @@ namespace cube_scan_matcher {
 
 class CoincidenceObjective {
  public:
-  /// Keeps references to `grid` and `scan`: both must outlive the objective. All memory the
-  /// evaluation needs is allocated here, none per evaluation.
+  /// Keeps pointers to `grid` and `scan`: both must outlive the objective (or the next
+  /// setScan()). All memory the evaluation needs is allocated here and in setScan(), none per
+  /// evaluation.
   CoincidenceObjective(const CubeGrid& grid, const PointArray& scan);
+  /// No scan yet: evaluate() gives 0 until setScan().
+  explicit CoincidenceObjective(const CubeGrid& grid);
+
+  /// Evaluates `scan` from now on, keeping the working copy of V (no reallocation of it).
+  void setScan(const PointArray& scan);
+  /// Evaluates on `grid` from now on. The working copy is reused, in O(l_old + l_new) steps
+  /// plus any growth of it. The previous grid must still be alive during this call. Unbinds the scan: call setScan() before evaluating.
+  void setGrid(const CubeGrid& grid);
 
   /// J for pose [x, y, z, roll, pitch, yaw] (eq. 2): transform every scan point, skip it if
-  /// outside the grid, count each set cube once by clearing its bit in a working copy of V
-  /// when hit, then restore the cleared bits. O(n) and independent of E (section 2.2).
+  /// outside the grid, count each set cube once by clearing it in a working copy of V when
+  /// hit, then restore the cleared cubes. O(n) and independent of E (section 2.2).
   int evaluate(const Pose6& pose);
   int operator()(const Pose6& pose) { return evaluate(pose); }
 
   /// Number of evaluations so far.
   long evaluations() const { return evaluations_; }
   /// True if the working copy of V equals the grid's V (it must, between evaluations).
-  bool workingCopyRestored() const {
-    return std::equal(grid_.bits().begin(), grid_.bits().end(), work_.begin()) &&
-           work_.back() == 0;
-  }
+  bool workingCopyRestored() const;
+  /// The working copy holds a byte per cube (else a bit per cube, as V).
+  bool bytePerCube() const { return !bytes_.empty(); }
 
  private:
   static constexpr std::size_t kBlock = 1024;  // points per index block (stays in L1)
-  const CubeGrid& grid_;
-  const PointArray& scan_;
-  std::vector<std::uint64_t> work_;  // V, cleared on hit and restored after each evaluation
-  std::vector<std::int32_t> hits_;   // indices cleared in this evaluation (J of them)
-  std::vector<std::int32_t> idx_;    // block of cube indices
-  std::int32_t outside_ = 0;         // index of the spare zero cube past V
+  void initWorkingCopy();  // from *grid_; byte copies must be all zero on entry
+  int countBytes(const GridAffine& g);
+  int countBits(const GridAffine& g);
+
+  const CubeGrid* grid_;
+  const PointArray* scan_ = nullptr;
+  // The working copy of V with a spare always-zero cube past the grid, into which outside
+  // points index: one byte per cube (grids up to max_byte_cubes) or one bit per cube.
+  std::vector<std::uint8_t> bytes_;
+  std::vector<std::uint64_t> bits_;
+  std::vector<std::int32_t> hits_;  // bit mode: indices cleared in this evaluation (J of them)
+  std::vector<std::int32_t> idx_;   // block of cube indices
+  std::int32_t outside_ = 0;        // index of the spare zero cube
   long evaluations_ = 0;
 };
 

@@ -23,6 +23,11 @@ struct CubeGridSettings {
   /// Memory guard: largest allowed v = Nx*Ny*Nz [cubes = bits], in [1, 2^31]. The default
   /// 2^31 bits is 256 MiB; a larger grid (absurd extent or tiny E) is refused with an error.
   std::uint64_t max_cubes = std::uint64_t{1} << 31;
+  /// Beyond the paper: an objective's working copy of V uses one byte per cube (about 1.8x
+  /// faster counting, measured in BENCHMARK.md) for grids of up to this many cubes, and V's
+  /// one bit per cube above. Each thread of the search owns one working copy per grid, so
+  /// this bounds that memory at max_byte_cubes bytes per copy. 0 = always bits. In [0, 2^28].
+  std::uint64_t max_byte_cubes = std::uint64_t{1} << 22;
   /// Beyond the paper: the grid origin is moved to min - origin_shift * E (same on all axes),
   /// in [0, 1). Grids with different shifts cut space at different places; summing their J
   /// smooths the aliasing of a single grid. 0 = the paper's grid.
@@ -67,6 +72,8 @@ class CubeGrid {
   std::uint64_t cubeCount() const { return std::uint64_t(dims_.x()) * dims_.y() * dims_.z(); }
   /// l: number of set cubes (length of L).
   std::size_t occupiedCount() const { return list_.size(); }
+  /// Whether an objective's working copy of V uses a byte per cube (see max_byte_cubes).
+  bool bytePerCube() const { return cubeCount() <= max_byte_cubes_; }
 
   /// Linear index (eq. 5) of the cube holding p = R q + t, or -1 if outside the grid.
   std::int64_t index(const Eigen::Vector3f& p) const;
@@ -83,6 +90,7 @@ class CubeGrid {
 
  private:
   double edge_ = 0.0;
+  std::uint64_t max_byte_cubes_ = 0;
   Eigen::Vector3d min_ = Eigen::Vector3d::Zero();
   Eigen::Vector3d max_ = Eigen::Vector3d::Zero();
   Eigen::Vector3i dims_ = Eigen::Vector3i::Zero();

@@ -30,6 +30,11 @@ struct PointArray {
     z.push_back(pz);
   }
   Eigen::Vector3f point(std::size_t i) const { return {x[i], y[i], z[i]}; }
+  /// A shared empty array (for objects that must always point at some array).
+  static const PointArray& empty_array() {
+    static const PointArray none;
+    return none;
+  }
 };
 
 }  // namespace cube_scan_matcher

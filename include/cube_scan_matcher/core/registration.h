@@ -3,6 +3,8 @@
 #pragma once
 
 #include <cstddef>
+#include <memory>
+#include <mutex>
 #include <string>
 #include <vector>
 
@@ -28,12 +30,19 @@ struct RefineSettings {
   /// Weight of J on the coarse grid (edge E) added to the fine grids' sum; 0 = fine grids
   /// only. In [0, 100].
   double coarse_weight = 0.0;
+  /// Grids of edge E in that coarse term, shifted by k/coarse_grids of a cube (k = 0 is the
+  /// coarse stage's grid); each adds coarse_weight * J. In [1, 8].
+  int coarse_grids = 1;
   /// Distinct coarse results (of the independent starts, by decreasing J) refined; the highest
   /// fine J wins. In [1, 64].
   int candidates = 1;
   /// The refine stage evaluates the scan collapsed to one point per voxel of this * E (the
   /// coarse stage uses RegistrationSettings::collapse_fraction). 0 = all points. In [0, 1].
   double collapse_fraction = 0.25;
+  /// Rotations of the compass search pivot about the centroid of the scan points instead of
+  /// the scan origin, so that a rotation step does not also move far points sideways: pitch
+  /// and z (yaw and y, ...) decouple. The result is the same pose parametrisation (eq. 2).
+  bool centroid_pivot = true;
   /// Compass search on the fine objective: first steps 0.125 m / 1 deg, halved 5 times.
   CompassSettings compass;
 };
@@ -44,8 +53,8 @@ struct SearchSettings {
   /// Independent GNMM searches from the initial estimate, seeds gnmm.seed + k; the highest J
   /// wins (ties: lowest k). In [1, 64]. Fewer run when `consensus` is reached early.
   int starts = 1;
-  /// Threads the starts run on, in rounds of `threads` starts; each thread owns a working
-  /// copy of V. In [1, 64].
+  /// Threads the starts (and the refine candidates) run on, in rounds of `threads`; each
+  /// thread owns a working copy of every grid. In [1, 64].
   int threads = 1;
   /// Stop after a round once this many finished starts agree with the best one (within the
   /// tolerances below); 0 = always run every start. In [0, 64].
@@ -98,6 +107,9 @@ struct RegistrationResult {
   int J_coarse = 0;                ///< J at E after the first stage (= J when refine is off).
   GnmmStop stop = GnmmStop::MaxIterations;  ///< why the winning GNMM run stopped.
   double time_s = 0.0;            ///< wall time of align() [s].
+  double time_coarse_s = 0.0;     ///< of which the coarse stage (GNMM starts, polish) [s].
+  double time_refine_s = 0.0;     ///< of which the refine stage [s].
+  int evaluations_refine = 0;     ///< of `evaluations`, those of the refine stage.
   std::string message;            ///< human-readable summary or reason of failure.
 
   bool ok() const { return status == RegistrationStatus::Ok; }
@@ -108,16 +120,24 @@ struct RegistrationResult {
 class CubeRegistration {
  public:
   explicit CubeRegistration(const RegistrationSettings& settings);  // validates
+  ~CubeRegistration();
+  CubeRegistration(CubeRegistration&&) noexcept;
+  CubeRegistration& operator=(CubeRegistration&&) noexcept;
+  CubeRegistration(const CubeRegistration&) = delete;
+  CubeRegistration& operator=(const CubeRegistration&) = delete;
 
   /// Builds V and L of the reference (finite points; see filters.h). Throws CubeGridError;
   /// on error the previous reference is kept.
   void setReference(const PointArray& reference);
-  bool hasReference() const { return has_reference_; }
-  const CubeGrid& grid() const { return grid_; }
+  bool hasReference() const;
+  const CubeGrid& grid() const;
   /// The fine grids of the refine stage (none when refine is off).
-  const std::vector<CubeGrid>& fineGrids() const { return fine_grids_; }
+  const std::vector<CubeGrid>& fineGrids() const;
+  /// The shifted E grids of the refine stage's coarse term (k = 1..coarse_grids-1).
+  const std::vector<CubeGrid>& shiftedCoarseGrids() const;
 
-  /// Registers `scan` to the reference around `guess` (scan -> reference).
+  /// Registers `scan` to the reference around `guess` (scan -> reference). Calls on one
+  /// instance are serialised (they share the per-thread working copies of the grids).
   RegistrationResult align(const PointArray& scan, const Pose6& guess) const;
 
   /// J of `scan` at `pose` on the coarse grid, with the same scan preparation as align()
@@ -125,25 +145,31 @@ class CubeRegistration {
   int score(const PointArray& scan, const Pose6& pose) const;
 
   const RegistrationSettings& settings() const { return settings_; }
-  /// Takes effect at the next setReference()/align(); validates. A new cube_edge or max_cubes
-  /// needs a new setReference() (the grid is rebuilt only there).
+  /// Takes effect at the next setReference()/align(); validates. A new cube_edge, max_cubes
+  /// or refine grid setting needs a new setReference() (the grids are rebuilt only there).
   void setSettings(const RegistrationSettings& settings);
 
  private:
-  /// The coarse stage on `objective` (the grid of edge E): settings_.search.starts GNMM runs
-  /// from `guess`, then the polish runs. Counts of all runs are summed into the result.
-  GnmmResult coarseSearch(const PointArray& points, const Pose6& guess,
-                          CoincidenceObjective& objective,
-                          std::vector<Vector6d>* candidates = nullptr) const;
+  struct Reference;  // the grids of the reference scan
+  struct Workspace;  // one thread's objectives (working copies) on those grids
+
+  /// The coarse stage: settings_.search.starts GNMM runs from `guess` on the workspaces'
+  /// coarse objectives, then the polish runs. Counts of all runs are summed into the result.
+  GnmmResult coarseSearch(const Pose6& guess, std::vector<Vector6d>* candidates) const;
+  /// The refine stage from `candidates` on `points`; returns the best pose and its value.
+  void refine(const PointArray& points, std::vector<Vector6d> candidates,
+              RegistrationResult& res) const;
+  /// Makes `count` workspaces on the current reference (reusing existing ones).
+  void prepareWorkspaces(int count) const;
 
   /// The points the objective evaluates: `scan` itself, or its collapsed copy in `storage`.
   const PointArray& prepareScan(const PointArray& scan, PointArray& storage,
                                 double fraction) const;
 
   RegistrationSettings settings_;
-  CubeGrid grid_;
-  std::vector<CubeGrid> fine_grids_;
-  bool has_reference_ = false;
+  std::unique_ptr<Reference> reference_;  // stable address: the workspaces point into it
+  mutable std::vector<std::unique_ptr<Workspace>> workspaces_;
+  mutable std::unique_ptr<std::mutex> mutex_;  // serialises align() and score()
 };
 
 }  // namespace cube_scan_matcher
