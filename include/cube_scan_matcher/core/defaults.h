@@ -18,6 +18,7 @@ inline RegistrationSettings defaultSettings() {
   RegistrationSettings s = RegistrationSettings::paper(0.5);
   s.collapse_fraction = 0.25;
   s.search.starts = 4;
+  s.gnmm.max_iterations = 300;
   s.search.threads = 2;
   s.search.consensus = 0;
   s.search.polish_runs = 0;
@@ -28,7 +29,7 @@ inline RegistrationSettings defaultSettings() {
   s.refine.grids = 3;
   s.refine.collapse_fraction = 0.25;
   s.refine.candidates = 2;
-  s.refine.coarse_weight = 1.0;
+  s.refine.coarse_weight = 3.0;
   return s;
 }
 
