@@ -104,8 +104,10 @@ NodeParams loadParams(const ros::NodeHandle& pnh) {
   p.max_rate = readParam(pnh, "max_rate", p.max_rate, 0.0, 1e6, "Hz");
   if (p.max_rate <= p.min_rate) throw ParamError("parameter ~max_rate must exceed ~min_rate");
   p.max_latency = readParam(pnh, "max_latency", p.max_latency, 1e-3, 1000.0, "s");
-  const double megabytes = readParam(pnh, "max_grid_megabytes", 256.0, 1.0, 65536.0, "MB");
+  const double megabytes = readParam(pnh, "max_grid_megabytes", 256.0, 1.0, 256.0, "MB");
   p.matcher.registration.grid.max_cubes = std::uint64_t(megabytes * 8.0 * 1024.0 * 1024.0);
+  const double byte_megabytes = readParam(pnh, "byte_grid_megabytes", 4.0, 0.0, 256.0, "MB");
+  p.matcher.registration.grid.max_byte_cubes = std::uint64_t(byte_megabytes * 1024.0 * 1024.0);
 
   // Live parameters: ranges as in cfg/ScanMatcher.cfg.
   ScanMatcherConfig c = toConfig(p);

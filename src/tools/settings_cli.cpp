@@ -48,10 +48,15 @@ std::string algorithmOptionsHelp() {
          "                        1/K cube (default " + std::to_string(d.refine.coarse_grids) + ")\n"
          "  --refine-grids K      refine on the sum of J over K fine grids shifted by 1/K cube\n"
          "                        (anti-aliasing; default " + std::to_string(d.refine.grids) + ")\n"
+         "  --refine-pivot P      compass rotations turn about the scan 'centroid' or its 'origin'\n"
+         "                        (default " + std::string(d.refine.centroid_pivot ? "centroid" : "origin") + ")\n"
          "  --refine-levels N     compass-search step halvings in the refine stage (default " + std::to_string(d.refine.compass.levels) + ")\n"
          "  --refine-step T A     first compass steps T [m], A [deg] (default " + num(d.refine.compass.initial_step[0]) + " m, " + num(rad2deg(d.refine.compass.initial_step[3])) + " deg)\n"
          "  --seed N              RNG seed (default " + std::to_string(d.gnmm.seed) + ")\n"
          "  --max-cubes N         memory cap on the grid [cubes = bits] (default 2^31)\n"
+         "  --max-byte-cubes N    grids of up to N cubes are evaluated on byte-per-cube working\n"
+         "                        copies (faster), larger ones on bit copies; 0 = bits (default\n"
+         "                        " + std::to_string(d.grid.max_byte_cubes) + ")\n"
          "  --min-range R         drop points closer than R [m] to the origin (default " + num(f.min_range) + ")\n"
          "  --max-range R         drop points farther than R [m] (default none)\n"
          "  --paper               the paper's fixed mode: 15 vertices, 500 iterations, all points,\n"
@@ -123,6 +128,15 @@ bool parseAlgorithmOption(const std::vector<std::string>& args, std::size_t& i,
     s.collapse_fraction = value(1), used = 2;
   } else if (a == "--seed") {
     s.gnmm.seed = std::uint64_t(value(1)), used = 2;
+  } else if (a == "--max-byte-cubes") {
+    s.grid.max_byte_cubes = std::uint64_t(value(1)), used = 2;
+  } else if (a == "--refine-pivot") {
+    if (i + 1 >= args.size()) throw std::invalid_argument(a + ": missing value");
+    const std::string& v = args[i + 1];
+    if (v != "centroid" && v != "origin") {
+      throw std::invalid_argument(a + ": expected centroid or origin, got '" + v + "'");
+    }
+    s.refine.centroid_pivot = v == "centroid", used = 2;
   } else if (a == "--max-cubes") {
     s.grid.max_cubes = std::uint64_t(value(1)), used = 2;
   } else if (a == "--min-range") {
