@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <exception>
 #include <memory>
 #include <mutex>
 #include <sstream>
@@ -173,20 +174,40 @@ const std::vector<CubeGrid>& CubeRegistration::shiftedCoarseGrids() const {
 
 void CubeRegistration::setReference(const PointArray& reference) {
   // All grids are built before any is replaced, so an error keeps the previous reference.
-  auto next = std::make_unique<Reference>();
-  next->grid = CubeGrid::build(reference, settings_.grid);
+  // The grid settings: the E grid, the shifted E grids, the fine grids; built on the threads.
+  std::vector<CubeGridSettings> specs{settings_.grid};
   if (settings_.refine.enabled) {
     CubeGridSettings gs = settings_.grid;
     for (int k = 1; k < settings_.refine.coarse_grids && settings_.refine.coarse_weight > 0.0;
          ++k) {
       gs.origin_shift = double(k) / settings_.refine.coarse_grids;
-      next->shifted.push_back(CubeGrid::build(reference, gs));
+      specs.push_back(gs);
     }
     gs.cube_edge *= settings_.refine.edge_fraction;
     for (int k = 0; k < settings_.refine.grids; ++k) {
       gs.origin_shift = double(k) / settings_.refine.grids;
-      next->fine.push_back(CubeGrid::build(reference, gs));
+      specs.push_back(gs);
     }
+  }
+  std::vector<CubeGrid> grids(specs.size());
+  std::vector<std::exception_ptr> errors(specs.size());
+  runOnThreads(int(specs.size()), settings_.search.threads, [&](int k, int) {
+    try {
+      grids[std::size_t(k)] = CubeGrid::build(reference, specs[std::size_t(k)]);
+    } catch (...) {
+      errors[std::size_t(k)] = std::current_exception();
+    }
+  });
+  for (const std::exception_ptr& e : errors) {
+    if (e) std::rethrow_exception(e);
+  }
+  auto next = std::make_unique<Reference>();
+  next->grid = std::move(grids[0]);
+  const std::size_t shifted = settings_.refine.enabled ? specs.size() - 1 -
+                                                             std::size_t(settings_.refine.grids)
+                                                       : 0;
+  for (std::size_t k = 1; k < specs.size(); ++k) {
+    (k <= shifted ? next->shifted : next->fine).push_back(std::move(grids[k]));
   }
   std::lock_guard<std::mutex> lock(*mutex_);
   // The working copies move to the new grids while the old ones are still alive.
