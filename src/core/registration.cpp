@@ -89,10 +89,17 @@ struct CubeRegistration::Reference {
 // One thread's objectives: a working copy of every grid, kept from one align() to the next
 // (and retargeted, not reallocated, when the reference changes).
 struct CubeRegistration::Workspace {
-  explicit Workspace(const Reference& r) : coarse(r.grid) { retarget(r); }
+  explicit Workspace(const Reference& r) : coarse(r.grid) {
+    retargetAll(fine, r.fine);
+    retargetAll(shifted, r.shifted);
+    target = &r;
+  }
 
+  // setReference() retargets every workspace before it frees the old reference, so `target`
+  // is always the current reference or the one being installed.
   void retarget(const Reference& r) {
-    if (target != &r) coarse.setGrid(r.grid);
+    if (target == &r) return;
+    coarse.setGrid(r.grid);
     retargetAll(fine, r.fine);
     retargetAll(shifted, r.shifted);
     target = &r;

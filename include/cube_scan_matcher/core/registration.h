@@ -121,6 +121,7 @@ class CubeRegistration {
  public:
   explicit CubeRegistration(const RegistrationSettings& settings);  // validates
   ~CubeRegistration();
+  /// Movable (a moved-from matcher may only be destroyed or assigned to), not copyable.
   CubeRegistration(CubeRegistration&&) noexcept;
   CubeRegistration& operator=(CubeRegistration&&) noexcept;
   CubeRegistration(const CubeRegistration&) = delete;
