@@ -6,6 +6,7 @@
 #include <cstdio>
 #include <algorithm>
 #include <random>
+#include <thread>
 #include <vector>
 
 #include "cube_scan_matcher/core/defaults.h"
@@ -171,6 +172,27 @@ TEST(Registration, AReusedMatcherGivesTheResultsOfAFreshOne) {
     EXPECT_TRUE(r.pose.isApprox(f.pose, 1e-12)) << k;
   }
   EXPECT_EQ(reused.score(a.second, ra.pose), ra.J);
+}
+
+TEST(Registration, ConcurrentAlignCallsGiveTheSequentialResults) {
+  // align() shares the per-thread working copies, so calls on one instance are serialised:
+  // two callers at once must get exactly what one caller gets.
+  const Scans s = makeScans(sim::SceneType::Urban, 3);
+  CubeRegistration reg(defaultSettings());
+  reg.setReference(s.first);
+  Pose6 g1 = isometryToPose(s.T_first_second), g2 = g1;
+  g1[0] += 0.5;
+  g2[4] += deg2rad(4);
+  const RegistrationResult a = reg.align(s.second, g1), b = reg.align(s.second, g2);
+  RegistrationResult ca, cb;
+  std::thread t1([&] { ca = reg.align(s.second, g1); });
+  std::thread t2([&] { cb = reg.align(s.second, g2); });
+  t1.join();
+  t2.join();
+  EXPECT_TRUE(ca.pose.isApprox(a.pose, 1e-12));
+  EXPECT_TRUE(cb.pose.isApprox(b.pose, 1e-12));
+  EXPECT_EQ(ca.J, a.J);
+  EXPECT_EQ(cb.J, b.J);
 }
 
 TEST(Registration, SettingsAreValidated) {
