@@ -43,8 +43,7 @@ struct RefineSettings {
   /// the scan origin, so that a rotation step does not also move far points sideways: pitch
   /// and z (yaw and y, ...) decouple. The result is the same pose parametrisation (eq. 2).
   bool centroid_pivot = true;
-  /// Compass search on the fine objective: first steps 0.125 m / 1 deg, 5 levels (the
-  /// package defaults, defaults.h, use 7).
+  /// Compass search on the fine objective: first steps 0.125 m / 1 deg, halved 5 times.
   CompassSettings compass;
 };
 
