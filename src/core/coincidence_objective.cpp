@@ -73,52 +73,52 @@ int CoincidenceObjective::evaluate(const Pose6& pose) {
   return bytePerCube() ? countBytes(g) : countBits(g);
 }
 
-int CoincidenceObjective::countBytes(const GridAffine& g) {
+template <typename CountBlock>
+void CoincidenceObjective::forEachIndexBlock(const GridAffine& g, CountBlock&& count_block) {
   const Eigen::Vector3f& dims = grid_->dimsF();
-  std::uint8_t* const v = bytes_.data();
   const PointArray& scan = *scan_;
-  int j = 0;
   for (std::size_t begin = 0; begin < scan.size(); begin += kBlock) {
     const std::size_t m = std::min(kBlock, scan.size() - begin);
     computeCubeIndices(g, dims, scan.x.data() + begin, scan.y.data() + begin,
                        scan.z.data() + begin, m, outside_, idx_.data());
-    // A set cube hit for the first time counts 1 and is cleared; a clear cube, a cube already
-    // hit and the spare outside cube count 0. The store does not depend on the load, so
-    // consecutive points in the same cube do not wait on each other.
-    const std::int32_t* id = idx_.data();
+    count_block(idx_.data(), m);
+  }
+}
+
+int CoincidenceObjective::countBytes(const GridAffine& g) {
+  std::uint8_t* const v = bytes_.data();
+  int j = 0;
+  // A set cube hit for the first time counts 1 and is cleared; a clear cube, a cube already
+  // hit and the spare outside cube count 0. The store does not depend on the load, so
+  // consecutive points in the same cube do not wait on each other.
+  forEachIndexBlock(g, [v, &j](const std::int32_t* id, std::size_t m) {
     for (std::size_t i = 0; i < m; ++i) {
       std::uint8_t& cube = v[std::uint32_t(id[i])];
       j += cube;
       cube = 0;
     }
-  }
+  });
   // Restore from L (the paper's way, l stores): cheaper than recording the J hits in the loop.
   for (std::int32_t c : grid_->list()) v[std::size_t(c)] = 1;
   return j;
 }
 
 int CoincidenceObjective::countBits(const GridAffine& g) {
-  const Eigen::Vector3f& dims = grid_->dimsF();
   std::uint64_t* const v = bits_.data();
   std::int32_t* const hits = hits_.data();
-  const PointArray& scan = *scan_;
   int j = 0;
-  for (std::size_t begin = 0; begin < scan.size(); begin += kBlock) {
-    const std::size_t m = std::min(kBlock, scan.size() - begin);
-    computeCubeIndices(g, dims, scan.x.data() + begin, scan.y.data() + begin,
-                       scan.z.data() + begin, m, outside_, idx_.data());
-    // Branch-free: a set cube hit for the first time is counted and cleared; a clear cube,
-    // a cube already hit, and the spare outside cube change nothing. Consecutive scan points
-    // mostly hit the same word of V, so one stream would wait on its own store at every point;
-    // four interleaved streams (quarters of the block) overlap those waits.
-    auto count = [v, hits, &j](std::uint32_t c) {
-      std::uint64_t& w = v[c >> 6];
-      const std::uint64_t hit = (w >> (c & 63)) & 1u;
-      w &= ~(hit << (c & 63));
-      hits[j] = std::int32_t(c);
-      j += int(hit);
-    };
-    const std::int32_t* id = idx_.data();
+  // Branch-free: a set cube hit for the first time is counted and cleared; a clear cube,
+  // a cube already hit, and the spare outside cube change nothing. Consecutive scan points
+  // mostly hit the same word of V, so one stream would wait on its own store at every point;
+  // four interleaved streams (quarters of the block) overlap those waits.
+  auto count = [v, hits, &j](std::uint32_t c) {
+    std::uint64_t& w = v[c >> 6];
+    const std::uint64_t hit = (w >> (c & 63)) & 1u;
+    w &= ~(hit << (c & 63));
+    hits[j] = std::int32_t(c);
+    j += int(hit);
+  };
+  forEachIndexBlock(g, [&count](const std::int32_t* id, std::size_t m) {
     const std::size_t q = m / 4;
     for (std::size_t i = 0; i < q; ++i) {
       count(std::uint32_t(id[i]));
@@ -127,7 +127,7 @@ int CoincidenceObjective::countBits(const GridAffine& g) {
       count(std::uint32_t(id[i + 3 * q]));
     }
     for (std::size_t i = 4 * q; i < m; ++i) count(std::uint32_t(id[i]));
-  }
+  });
   // Restore V from the hits (J <= l steps; the paper restores from L, l steps).
   for (int k = 0; k < j; ++k) {
     v[std::size_t(hits[k]) >> 6] |= std::uint64_t{1} << (hits[k] & 63);

@@ -183,6 +183,7 @@ void CubeRegistration::setReference(const PointArray& reference) {
   // All grids are built before any is replaced, so an error keeps the previous reference.
   // The grid settings: the E grid, the shifted E grids, the fine grids; built on the threads.
   std::vector<CubeGridSettings> specs{settings_.grid};
+  std::size_t shifted = 0;  // specs[1..shifted] are the shifted E grids, the rest fine grids
   if (settings_.refine.enabled) {
     CubeGridSettings gs = settings_.grid;
     for (int k = 1; k < settings_.refine.coarse_grids && settings_.refine.coarse_weight > 0.0;
@@ -190,6 +191,7 @@ void CubeRegistration::setReference(const PointArray& reference) {
       gs.origin_shift = double(k) / settings_.refine.coarse_grids;
       specs.push_back(gs);
     }
+    shifted = specs.size() - 1;
     gs.cube_edge *= settings_.refine.edge_fraction;
     for (int k = 0; k < settings_.refine.grids; ++k) {
       gs.origin_shift = double(k) / settings_.refine.grids;
@@ -210,9 +212,6 @@ void CubeRegistration::setReference(const PointArray& reference) {
   }
   auto next = std::make_unique<Reference>();
   next->grid = std::move(grids[0]);
-  const std::size_t shifted = settings_.refine.enabled ? specs.size() - 1 -
-                                                             std::size_t(settings_.refine.grids)
-                                                       : 0;
   for (std::size_t k = 1; k < specs.size(); ++k) {
     (k <= shifted ? next->shifted : next->fine).push_back(std::move(grids[k]));
   }

@@ -76,10 +76,11 @@ double parseNumber(const std::string& option, const std::string& value) {
 bool parseAlgorithmOption(const std::vector<std::string>& args, std::size_t& i,
                           RegistrationSettings& s, RangeFilterSettings& f) {
   const std::string& a = args[i];
-  auto value = [&](int k) -> double {
+  auto word = [&](int k) -> const std::string& {
     if (i + k >= args.size()) throw std::invalid_argument(a + ": missing value");
-    return parseNumber(a, args[i + k]);
+    return args[i + k];
   };
+  auto value = [&](int k) { return parseNumber(a, word(k)); };
   std::size_t used = 1;
   if (a == "--edge") {
     s.grid.cube_edge = value(1), used = 2;
@@ -132,8 +133,7 @@ bool parseAlgorithmOption(const std::vector<std::string>& args, std::size_t& i,
   } else if (a == "--max-byte-cubes") {
     s.grid.max_byte_cubes = std::uint64_t(value(1)), used = 2;
   } else if (a == "--refine-pivot") {
-    if (i + 1 >= args.size()) throw std::invalid_argument(a + ": missing value");
-    const std::string& v = args[i + 1];
+    const std::string& v = word(1);
     if (v != "centroid" && v != "origin") {
       throw std::invalid_argument(a + ": expected centroid or origin, got '" + v + "'");
     }

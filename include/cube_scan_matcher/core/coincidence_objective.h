@@ -42,6 +42,10 @@ class CoincidenceObjective {
  private:
   static constexpr std::size_t kBlock = 1024;  // points per index block (stays in L1)
   void initWorkingCopy();  // from *grid_; byte copies must be all zero on entry
+  /// Computes the cube indices of the scan block by block and hands each block to
+  /// count_block(indices, m): the loop both counters share (inlined, no call per point).
+  template <typename CountBlock>
+  void forEachIndexBlock(const GridAffine& g, CountBlock&& count_block);
   int countBytes(const GridAffine& g);
   int countBits(const GridAffine& g);
 
