@@ -66,7 +66,6 @@ bool CoincidenceObjective::workingCopyRestored() const {
 }
 
 int CoincidenceObjective::evaluate(const Pose6& pose) {
-  ++evaluations_;
   if (!scan_ || scan_->empty()) return 0;
   const Eigen::Isometry3d t = poseToIsometry(pose);
   const GridAffine g = grid_->affine(t.linear().cast<float>(), t.translation().cast<float>());

@@ -4,6 +4,7 @@
 #include <cmath>
 #include <random>
 #include <stdexcept>
+#include <vector>
 
 namespace cube_scan_matcher {
 
@@ -18,16 +19,6 @@ void validate(const GnmmSettings& s) {
   if (!(s.reflection > 0.0)) fail("reflection must be > 0");
   if (!(s.expansion > 1.0)) fail("expansion must be > 1");
   if (!(s.contraction > 0.0 && s.contraction < 1.0)) fail("contraction must be in (0, 1)");
-  if (s.stall_iterations < 0) fail("stall_iterations must be >= 0");
-  if (!(s.restart_shrink > 0.0 && s.restart_shrink <= 1.0)) fail("restart_shrink must be in (0, 1]");
-}
-
-std::string toString(GnmmStop stop) {
-  switch (stop) {
-    case GnmmStop::MaxIterations: return "max_iterations";
-    case GnmmStop::Stalled: return "stalled";
-  }
-  return "unknown";
 }
 
 Gnmm::Gnmm(const GnmmSettings& settings) : settings_(settings) { validate(settings_); }
@@ -57,10 +48,6 @@ GnmmResult Gnmm::maximize(const Objective& f, const Vector6d& initial) const {
     x[i] = draw(initial, s.bounds);
     fx[i] = eval(x[i]);
   }
-  Vector6d restart_half = s.bounds;
-
-  double best_ever = *std::max_element(fx.begin(), fx.end());
-  int last_improvement = 0;
   for (r.iterations = 0; r.iterations < s.max_iterations;) {
     ++r.iterations;
     // Worst (lowest f), second worst and best vertex.
@@ -108,29 +95,17 @@ GnmmResult Gnmm::maximize(const Objective& f, const Vector6d& initial) const {
         // Where Nelder-Mead would shrink towards the best vertex, GNMM keeps the best vertex
         // and restarts all others at random around the initial estimate.
         ++r.restarts;
-        const Vector6d center = s.restart_shrink < 1.0 ? x[best] : initial;
-        if (s.restart_shrink < 1.0) restart_half *= s.restart_shrink;
         for (int i = 0; i < n; ++i) {
           if (i == best) continue;
-          x[i] = draw(center, restart_half);
+          x[i] = draw(initial, s.bounds);
           fx[i] = eval(x[i]);
         }
       }
-    }
-    const double top = *std::max_element(fx.begin(), fx.end());
-    if (top > best_ever) {
-      best_ever = top;
-      last_improvement = r.iterations;
-    } else if (s.stall_iterations > 0 && r.iterations - last_improvement >= s.stall_iterations) {
-      r.stop = GnmmStop::Stalled;
-      break;
     }
   }
   const int best = int(std::max_element(fx.begin(), fx.end()) - fx.begin());
   r.best = x[best];
   r.best_value = fx[best];
-  r.vertices = std::move(x);
-  r.values = std::move(fx);
   return r;
 }
 

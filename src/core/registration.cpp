@@ -34,11 +34,12 @@ void requireInRange(const char* name, T value, T lo, T hi) {
   }
 }
 
-/// Two poses within the search's agreement tolerances (translation norm, each angle).
-bool samePose(const Vector6d& a, const Vector6d& b, const SearchSettings& ss) {
+/// Two poses within the refine stage's distinct-candidate tolerances (translation norm, each
+/// angle).
+bool samePose(const Vector6d& a, const Vector6d& b, const RefineSettings& rs) {
   const Vector6d d = a - b;
-  return d.head<3>().norm() <= ss.consensus_translation &&
-         d.tail<3>().cwiseAbs().maxCoeff() <= ss.consensus_rotation;
+  return d.head<3>().norm() <= rs.distinct_translation &&
+         d.tail<3>().cwiseAbs().maxCoeff() <= rs.distinct_rotation;
 }
 
 }  // namespace
@@ -55,17 +56,13 @@ void validate(const RegistrationSettings& s) {
     requireInRange("refine coarse_weight", s.refine.coarse_weight, 0.0, 100.0);
     requireInRange("refine candidates", s.refine.candidates, 1, 64);
     requireInRange("refine grids", s.refine.grids, 1, 8);
-    requireInRange("refine coarse_grids", s.refine.coarse_grids, 1, 8);
     requireInRange("refine collapse_fraction", s.refine.collapse_fraction, 0.0, 1.0);
+    if (!(s.refine.distinct_translation > 0.0 && s.refine.distinct_rotation > 0.0)) {
+      throw std::invalid_argument("refine distinct_translation and distinct_rotation must be > 0");
+    }
   }
   requireInRange("search starts", s.search.starts, 1, 64);
   requireInRange("search threads", s.search.threads, 1, 64);
-  requireInRange("search consensus", s.search.consensus, 0, 64);
-  if (!(s.search.consensus_translation > 0.0 && s.search.consensus_rotation > 0.0)) {
-    throw std::invalid_argument("search consensus tolerances must be > 0");
-  }
-  requireInRange("search polish_runs", s.search.polish_runs, 0, 10);
-  requireInRange("search polish_iterations", s.search.polish_iterations, 1, 1000000);
   requireInRange("collapse_fraction", s.collapse_fraction, 0.0, 1.0);
 }
 
@@ -83,7 +80,6 @@ std::string toString(RegistrationStatus status) {
 struct CubeRegistration::Reference {
   CubeGrid grid;                   // edge E: the coarse stage (and the refine's coarse term)
   std::vector<CubeGrid> fine;      // edge edge_fraction * E, shifted: the refine stage
-  std::vector<CubeGrid> shifted;   // edge E, shifted: more of the refine's coarse term
 };
 
 // One thread's objectives: a working copy of every grid, kept from one align() to the next
@@ -91,7 +87,6 @@ struct CubeRegistration::Reference {
 struct CubeRegistration::Workspace {
   explicit Workspace(const Reference& r) : coarse(r.grid) {
     retargetAll(fine, r.fine);
-    retargetAll(shifted, r.shifted);
     target = &r;
   }
 
@@ -101,12 +96,11 @@ struct CubeRegistration::Workspace {
     if (target == &r) return;
     coarse.setGrid(r.grid);
     retargetAll(fine, r.fine);
-    retargetAll(shifted, r.shifted);
     target = &r;
   }
 
   CoincidenceObjective coarse;
-  std::vector<CoincidenceObjective> fine, shifted;
+  std::vector<CoincidenceObjective> fine;
   const Reference* target = nullptr;
 
  private:
@@ -169,29 +163,12 @@ const CubeGrid& CubeRegistration::grid() const {
   return reference_ ? reference_->grid : empty;
 }
 
-const std::vector<CubeGrid>& CubeRegistration::fineGrids() const {
-  static const std::vector<CubeGrid> none;
-  return reference_ ? reference_->fine : none;
-}
-
-const std::vector<CubeGrid>& CubeRegistration::shiftedCoarseGrids() const {
-  static const std::vector<CubeGrid> none;
-  return reference_ ? reference_->shifted : none;
-}
-
 void CubeRegistration::setReference(const PointArray& reference) {
   // All grids are built before any is replaced, so an error keeps the previous reference.
-  // The grid settings: the E grid, the shifted E grids, the fine grids; built on the threads.
+  // The grid settings: the E grid, then the fine grids; built on the threads.
   std::vector<CubeGridSettings> specs{settings_.grid};
-  std::size_t shifted = 0;  // specs[1..shifted] are the shifted E grids, the rest fine grids
   if (settings_.refine.enabled) {
     CubeGridSettings gs = settings_.grid;
-    for (int k = 1; k < settings_.refine.coarse_grids && settings_.refine.coarse_weight > 0.0;
-         ++k) {
-      gs.origin_shift = double(k) / settings_.refine.coarse_grids;
-      specs.push_back(gs);
-    }
-    shifted = specs.size() - 1;
     gs.cube_edge *= settings_.refine.edge_fraction;
     for (int k = 0; k < settings_.refine.grids; ++k) {
       gs.origin_shift = double(k) / settings_.refine.grids;
@@ -212,9 +189,7 @@ void CubeRegistration::setReference(const PointArray& reference) {
   }
   auto next = std::make_unique<Reference>();
   next->grid = std::move(grids[0]);
-  for (std::size_t k = 1; k < specs.size(); ++k) {
-    (k <= shifted ? next->shifted : next->fine).push_back(std::move(grids[k]));
-  }
+  for (std::size_t k = 1; k < specs.size(); ++k) next->fine.push_back(std::move(grids[k]));
   std::lock_guard<std::mutex> lock(*mutex_);
   // The working copies move to the new grids while the old ones are still alive.
   for (auto& w : workspaces_) w->retarget(*next);
@@ -251,31 +226,16 @@ int CubeRegistration::score(const PointArray& scan, const Pose6& pose) const {
 GnmmResult CubeRegistration::coarseSearch(const Pose6& guess,
                                           std::vector<Vector6d>* candidates) const {
   const SearchSettings& ss = settings_.search;
-  // Independent starts (seeds seed + k) in rounds of `threads` starts, one per thread, each
-  // on its thread's working copy of V. After each round, stop once `consensus` finished
-  // starts agree with the best one (the basin is found).
-  const int threads = std::min(ss.threads, ss.starts);
-  std::vector<GnmmResult> runs;
-  runs.reserve(std::size_t(ss.starts));
-  while (int(runs.size()) < ss.starts) {
-    const int first = int(runs.size()), count = std::min(threads, ss.starts - first);
-    runs.resize(std::size_t(first + count));
-    runOnThreads(count, threads, [&](int k, int t) {
-      CoincidenceObjective& f = workspaces_[std::size_t(t)]->coarse;
-      GnmmSettings gs = settings_.gnmm;
-      gs.seed += std::uint64_t(first + k);
-      runs[std::size_t(first + k)] =
-          Gnmm(gs).maximize([&f](const Vector6d& p) { return double(f(p)); }, guess);
-    });
-    if (ss.consensus > 0) {
-      const GnmmResult& top = *std::max_element(
-          runs.begin(), runs.end(),
-          [](const GnmmResult& a, const GnmmResult& b) { return a.best_value < b.best_value; });
-      int agree = 0;
-      for (const GnmmResult& r : runs) agree += samePose(r.best, top.best, ss);
-      if (agree >= ss.consensus) break;
-    }
-  }
+  // Independent starts (seeds seed + k), start k on thread k % threads, each on its thread's
+  // working copy of V.
+  std::vector<GnmmResult> runs(std::size_t(ss.starts));
+  runOnThreads(ss.starts, ss.threads, [&](int k, int t) {
+    CoincidenceObjective& f = workspaces_[std::size_t(t)]->coarse;
+    GnmmSettings gs = settings_.gnmm;
+    gs.seed += std::uint64_t(k);
+    runs[std::size_t(k)] =
+        Gnmm(gs).maximize([&f](const Vector6d& p) { return double(f(p)); }, guess);
+  });
 
   int evaluations = 0, iterations = 0, restarts = 0;
   for (const GnmmResult& r : runs) {
@@ -295,30 +255,12 @@ GnmmResult CubeRegistration::coarseSearch(const Pose6& guess,
     for (std::size_t k : order) {
       const bool distinct = std::none_of(
           candidates->begin(), candidates->end(),
-          [&](const Vector6d& c) { return samePose(runs[k].best, c, ss); });
+          [&](const Vector6d& c) { return samePose(runs[k].best, c, settings_.refine); });
       if (distinct) candidates->push_back(runs[k].best);
     }
   }
   GnmmResult best = std::move(runs[order.front()]);
   best.initial_value = runs[0].initial_value;
-
-  // Polish: GNMM around the best pose so far with the bounds halved at each run.
-  CoincidenceObjective& objective = workspaces_[0]->coarse;
-  GnmmSettings gs = settings_.gnmm;
-  gs.max_iterations = ss.polish_iterations;
-  for (int run = 0; run < ss.polish_runs; ++run) {
-    gs.bounds *= 0.5;
-    gs.seed = settings_.gnmm.seed + std::uint64_t(ss.starts + run);
-    const GnmmResult p = Gnmm(gs).maximize(
-        [&objective](const Vector6d& x) { return double(objective(x)); }, best.best);
-    evaluations += p.evaluations;
-    iterations += p.iterations;
-    restarts += p.restarts;
-    if (p.best_value > best.best_value) {
-      best.best = p.best;
-      best.best_value = p.best_value;
-    }
-  }
   best.evaluations = evaluations;
   best.iterations = iterations;
   best.restarts = restarts;
@@ -353,16 +295,12 @@ void CubeRegistration::refine(const PointArray& points, std::vector<Vector6d> ca
   runOnThreads(int(candidates.size()), settings_.search.threads, [&](int k, int t) {
     Workspace& ws = *workspaces_[std::size_t(t)];
     for (CoincidenceObjective& j : ws.fine) j.setScan(points);
-    for (CoincidenceObjective& j : ws.shifted) j.setScan(points);
     ws.coarse.setScan(points);
     auto value = [&ws, &toPose, w](const Vector6d& q) {
       const Pose6 p = toPose(q);
       int sum = 0, coarse_sum = 0;
       for (CoincidenceObjective& j : ws.fine) sum += j(p);
-      if (w > 0.0) {
-        coarse_sum = ws.coarse(p);
-        for (CoincidenceObjective& j : ws.shifted) coarse_sum += j(p);
-      }
+      if (w > 0.0) coarse_sum = ws.coarse(p);
       return double(sum) + w * double(coarse_sum);
     };
     results[std::size_t(k)] = compassMaximize(value, toQ(candidates[std::size_t(k)]), rs.compass);
@@ -418,7 +356,6 @@ RegistrationResult CubeRegistration::align(const PointArray& scan, const Pose6& 
   res.evaluations = g.evaluations;
   res.iterations = g.iterations;
   res.restarts = g.restarts;
-  res.stop = g.stop;
 
   // Refine stage (not in the paper): compass search on the fine grids from the coarse
   // results, on the scan collapsed at its own voxel; the default, E/4, is half a fine cube.
@@ -439,7 +376,6 @@ RegistrationResult CubeRegistration::align(const PointArray& scan, const Pose6& 
   for (auto& w : workspaces_) {
     w->coarse.setScan(PointArray::empty_array());
     for (CoincidenceObjective& j : w->fine) j.setScan(PointArray::empty_array());
-    for (CoincidenceObjective& j : w->shifted) j.setScan(PointArray::empty_array());
   }
   for (int k = 3; k < 6; ++k) res.pose[k] = wrapAngle(res.pose[k]);
   res.transform = poseToIsometry(res.pose);
@@ -449,7 +385,7 @@ RegistrationResult CubeRegistration::align(const PointArray& scan, const Pose6& 
   }
   std::ostringstream os;
   os << "J = " << res.J << " of l = " << res.reference_cubes << " (J at guess " << res.J_guess
-     << "), " << res.evaluations << " evaluations, stopped: " << toString(g.stop);
+     << "), " << res.evaluations << " evaluations";
   return finish(RegistrationStatus::Ok, os.str());
 }
 

@@ -79,8 +79,8 @@ int main(int argc, char** argv) {
                 r.overlap());
     std::printf("points: reference %zu of %zu, scan %zu of %zu, evaluated %zu\n", ref.size(),
                 ref_stats.input, scan.size(), scan_stats.input, r.points_used);
-    std::printf("evaluations %d, iterations %d, restarts %d, stopped: %s, time %.4f s\n",
-                r.evaluations, r.iterations, r.restarts, toString(r.stop).c_str(), r.time_s);
+    std::printf("evaluations %d, iterations %d, restarts %d, time %.4f s\n", r.evaluations,
+                r.iterations, r.restarts, r.time_s);
   } catch (const std::exception& e) {
     std::cerr << "register_clouds: " << e.what() << "\n";
     return 1;

@@ -20,21 +20,12 @@ std::string algorithmOptionsHelp() {
          "  --edge E              cube edge E [m] (default " + num(d.grid.cube_edge) + "; paper 0.3-0.5)\n"
          "  --vertices N          GNMM population size (default " + std::to_string(d.gnmm.vertices) + ", >= 7)\n"
          "  --iterations N        GNMM iterations (default " + std::to_string(d.gnmm.max_iterations) + ")\n"
-         "  --stall N             stop after N iterations without improvement, 0 = never\n"
-         "                        (default " + std::to_string(d.gnmm.stall_iterations) + ")\n"
-         "  --restart-shrink F    restart box factor around the best vertex, 1 = paper's restarts\n"
-         "                        around the initial estimate (default " + num(d.gnmm.restart_shrink) + ")\n"
          "  --bounds T A          restart half-widths: T [m] for x,y,z and A [deg] for roll,pitch,yaw\n"
          "                        (default " + num(d.gnmm.bounds[0]) + " m, " + num(rad2deg(d.gnmm.bounds[3])) + " deg)\n"
          "  --starts K            independent GNMM searches from the guess, best J wins\n"
          "                        (default " + std::to_string(d.search.starts) + "; paper 1)\n"
          "  --threads T           threads for the starts, the refine candidates and the grid\n"
          "                        builds (default " + std::to_string(d.search.threads) + ")\n"
-         "  --consensus K         stop the starts once K agree on the best pose, 0 = run all\n"
-         "                        (default " + std::to_string(d.search.consensus) + ")\n"
-         "  --polish-runs K       GNMM runs around the best pose, bounds halved each run\n"
-         "                        (default " + std::to_string(d.search.polish_runs) + "; paper 0)\n"
-         "  --polish-iterations N iterations of each polish run (default " + std::to_string(d.search.polish_iterations) + ")\n"
          "  --collapse F          keep one scan point per voxel of F*E before the search,\n"
          "                        0 = all points as in the paper (default " + num(d.collapse_fraction) + ")\n"
          "  --refine F            compass-search stage on cubes of F*E from the coarse result,\n"
@@ -45,8 +36,6 @@ std::string algorithmOptionsHelp() {
          "                        (default " + std::to_string(d.refine.candidates) + ")\n"
          "  --refine-collapse F   the refine stage evaluates one point per voxel of F*E\n"
          "                        (default " + num(d.refine.collapse_fraction) + ")\n"
-         "  --refine-coarse-grids K  the coarse term sums J over K grids of edge E shifted by\n"
-         "                        1/K cube (default " + std::to_string(d.refine.coarse_grids) + ")\n"
          "  --refine-grids K      refine on the sum of J over K fine grids shifted by 1/K cube\n"
          "                        (anti-aliasing; default " + std::to_string(d.refine.grids) + ")\n"
          "  --refine-pivot P      compass rotations turn about the scan 'centroid' or its 'origin'\n"
@@ -88,10 +77,6 @@ bool parseAlgorithmOption(const std::vector<std::string>& args, std::size_t& i,
     s.gnmm.vertices = int(value(1)), used = 2;
   } else if (a == "--iterations") {
     s.gnmm.max_iterations = int(value(1)), used = 2;
-  } else if (a == "--stall") {
-    s.gnmm.stall_iterations = int(value(1)), used = 2;
-  } else if (a == "--restart-shrink") {
-    s.gnmm.restart_shrink = value(1), used = 2;
   } else if (a == "--bounds") {
     const double t = value(1), ang = deg2rad(value(2));
     s.gnmm.bounds << t, t, t, ang, ang, ang;
@@ -106,8 +91,6 @@ bool parseAlgorithmOption(const std::vector<std::string>& args, std::size_t& i,
     s.refine.candidates = int(value(1)), used = 2;
   } else if (a == "--refine-collapse") {
     s.refine.collapse_fraction = value(1), used = 2;
-  } else if (a == "--refine-coarse-grids") {
-    s.refine.coarse_grids = int(value(1)), used = 2;
   } else if (a == "--refine-grids") {
     s.refine.grids = int(value(1)), used = 2;
   } else if (a == "--refine-levels") {
@@ -120,12 +103,6 @@ bool parseAlgorithmOption(const std::vector<std::string>& args, std::size_t& i,
     s.search.starts = int(value(1)), used = 2;
   } else if (a == "--threads") {
     s.search.threads = int(value(1)), used = 2;
-  } else if (a == "--consensus") {
-    s.search.consensus = int(value(1)), used = 2;
-  } else if (a == "--polish-runs") {
-    s.search.polish_runs = int(value(1)), used = 2;
-  } else if (a == "--polish-iterations") {
-    s.search.polish_iterations = int(value(1)), used = 2;
   } else if (a == "--collapse") {
     s.collapse_fraction = value(1), used = 2;
   } else if (a == "--seed") {

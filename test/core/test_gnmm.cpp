@@ -23,7 +23,6 @@ TEST(Gnmm, MaximisesASmoothFunctionFromADistantStart) {
   EXPECT_LT((r.best - kOptimum).norm(), 1e-3);
   EXPECT_GT(r.best_value, r.initial_value);
   EXPECT_EQ(r.iterations, 500);
-  EXPECT_EQ(r.stop, GnmmStop::MaxIterations);
   EXPECT_GE(r.evaluations, 15 + 500);
 }
 
@@ -65,15 +64,6 @@ TEST(Gnmm, IsReproducibleWithAFixedSeed) {
   s.seed = 8;
   const GnmmResult c = Gnmm(s).maximize(f, distantStart());
   EXPECT_NE(a.best, c.best);
-}
-
-TEST(Gnmm, StallStopsEarly) {
-  const auto f = [](const Vector6d&) { return 1.0; };  // flat: never improves
-  GnmmSettings s;
-  s.stall_iterations = 20;
-  const GnmmResult r = Gnmm(s).maximize(f, Vector6d::Zero());
-  EXPECT_EQ(r.stop, GnmmStop::Stalled);
-  EXPECT_EQ(r.iterations, 20);
 }
 
 TEST(Gnmm, SettingsOutOfRangeAreRefused) {

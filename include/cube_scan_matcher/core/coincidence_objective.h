@@ -32,8 +32,6 @@ class CoincidenceObjective {
   int evaluate(const Pose6& pose);
   int operator()(const Pose6& pose) { return evaluate(pose); }
 
-  /// Number of evaluations so far.
-  long evaluations() const { return evaluations_; }
   /// True if the working copy of V equals the grid's V (it must, between evaluations).
   bool workingCopyRestored() const;
   /// The working copy holds a byte per cube (else a bit per cube, as V).
@@ -58,7 +56,6 @@ class CoincidenceObjective {
   std::vector<std::int32_t> hits_;  // bit mode: indices cleared in this evaluation (J of them)
   std::vector<std::int32_t> idx_;   // block of cube indices
   std::int32_t outside_ = 0;        // index of the spare zero cube
-  long evaluations_ = 0;
 };
 
 }  // namespace cube_scan_matcher

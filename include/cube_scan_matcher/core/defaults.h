@@ -9,8 +9,7 @@ namespace cube_scan_matcher {
 /// keeps the paper's fixed mode.
 /// Coarse stage at E = 0.5 m on the scan collapsed to one point per E/4 voxel: four
 /// independent paper GNMM searches (15 vertices, 300 iterations, +-1 m/+-8 deg), two at a time
-/// on two threads; the highest J wins (consensus early stop and polish runs are available but
-/// off). Refine stage: compass search (0.125 m / 1 deg steps, halved 5 times, rotations about
+/// on two threads; the highest J wins. Refine stage: compass search (0.125 m / 1 deg steps, halved 5 times, rotations about
 /// the scan centroid) from the two best distinct coarse results, one per thread, on a
 /// multi-scale objective: the sum of J over three grids of E/2 cubes shifted by 1/3 of a fine
 /// cube, plus 3 x J on the E grid, on the same E/4-collapsed scan. Working copies of grids up
@@ -21,9 +20,6 @@ inline RegistrationSettings defaultSettings() {
   s.search.starts = 4;
   s.gnmm.max_iterations = 300;
   s.search.threads = 2;
-  s.search.consensus = 0;
-  s.search.polish_runs = 0;
-  s.search.polish_iterations = 100;
 
   s.refine.enabled = true;
   s.refine.edge_fraction = 0.5;

@@ -7,7 +7,6 @@
 #include <cstdint>
 #include <functional>
 #include <string>
-#include <vector>
 
 #include <Eigen/Core>
 
@@ -25,20 +24,11 @@ struct GnmmSettings {
   double reflection = 1.0;    ///< alpha > 0.
   double expansion = 2.0;     ///< gamma > 1.
   double contraction = 0.5;   ///< rho in (0, 1).
-  /// Stop when the best value has not improved for this many iterations; 0 = never (paper).
-  int stall_iterations = 0;
-  /// Restarts draw vertices around the initial estimate within `bounds` (paper). Values < 1
-  /// shrink the restart box around the *best* vertex instead, by this factor per restart
-  /// (beyond the paper; 1 = paper). In (0, 1].
-  double restart_shrink = 1.0;
   std::uint64_t seed = 42;    ///< RNG seed: equal seeds give equal runs.
 };
 
 /// Throws std::invalid_argument naming the bad setting.
 void validate(const GnmmSettings& settings);
-
-enum class GnmmStop { MaxIterations, Stalled };
-std::string toString(GnmmStop stop);
 
 struct GnmmResult {
   Vector6d best = Vector6d::Zero();
@@ -47,9 +37,6 @@ struct GnmmResult {
   int evaluations = 0;
   int iterations = 0;
   int restarts = 0;
-  GnmmStop stop = GnmmStop::MaxIterations;
-  std::vector<Vector6d> vertices;  ///< final population
-  std::vector<double> values;      ///< f at each final vertex
 };
 
 class Gnmm {

@@ -30,12 +30,13 @@ struct RefineSettings {
   /// Weight of J on the coarse grid (edge E) added to the fine grids' sum; 0 = fine grids
   /// only. In [0, 100].
   double coarse_weight = 0.0;
-  /// Grids of edge E in that coarse term, shifted by k/coarse_grids of a cube (k = 0 is the
-  /// coarse stage's grid); each adds coarse_weight * J. In [1, 8].
-  int coarse_grids = 1;
   /// Distinct coarse results (of the independent starts, by decreasing J) refined; the highest
   /// fine J wins. In [1, 64].
   int candidates = 1;
+  /// Two coarse results are one candidate when their translations differ by at most
+  /// distinct_translation [m] and each angle by at most distinct_rotation [rad]; both > 0.
+  double distinct_translation = 0.1;
+  double distinct_rotation = 0.017453292519943295;  // 1 deg
   /// The refine stage evaluates the scan collapsed to one point per voxel of this * E (the
   /// coarse stage uses RegistrationSettings::collapse_fraction). 0 = all points. In [0, 1].
   double collapse_fraction = 0.25;
@@ -48,29 +49,20 @@ struct RefineSettings {
 };
 
 /// Beyond the paper: how the coarse stage spends its evaluations. The paper runs one GNMM
-/// from the initial estimate (starts = 1, polish_runs = 0).
+/// from the initial estimate (starts = 1).
 struct SearchSettings {
   /// Independent GNMM searches from the initial estimate, seeds gnmm.seed + k; the highest J
-  /// wins (ties: lowest k). In [1, 64]. Fewer run when `consensus` is reached early.
+  /// wins (ties: lowest k). In [1, 64].
   int starts = 1;
   /// Threads the starts (and the refine candidates) run on, in rounds of `threads`; each
   /// thread owns a working copy of every grid. In [1, 64].
   int threads = 1;
-  /// Stop after a round once this many finished starts agree with the best one (within the
-  /// tolerances below); 0 = always run every start. In [0, 64].
-  int consensus = 0;
-  double consensus_translation = 0.1;             ///< [m], > 0.
-  double consensus_rotation = 0.017453292519943295;  ///< [rad] per angle, > 0 (1 deg).
-  /// Follow-up GNMM runs around the best pose so far, the restart bounds halved at each run
-  /// (a run keeps its result only if J improves). In [0, 10].
-  int polish_runs = 0;
-  int polish_iterations = 200;  ///< iterations of each polish run, in [1, 1e6].
 };
 
 struct RegistrationSettings {
   CubeGridSettings grid;  ///< E and the memory cap.
   GnmmSettings gnmm;      ///< population, iterations, restart bounds, seed.
-  SearchSettings search;  ///< starts, threads and polish runs of the coarse stage.
+  SearchSettings search;  ///< starts and threads of the coarse stage.
   RefineSettings refine;  ///< optional fine stage (off in the paper's mode).
   /// Beyond the paper: before the search, keep one scan point per voxel of edge
   /// collapse_fraction * E. 0 = off, every point is evaluated (paper). In [0, 1].
@@ -105,9 +97,8 @@ struct RegistrationResult {
   int iterations = 0;              ///< GNMM iterations, all runs.
   int restarts = 0;                ///< GNMM restarts, all runs.
   int J_coarse = 0;                ///< J at E after the first stage (= J when refine is off).
-  GnmmStop stop = GnmmStop::MaxIterations;  ///< why the winning GNMM run stopped.
   double time_s = 0.0;            ///< wall time of align() [s].
-  double time_coarse_s = 0.0;     ///< of which the coarse stage (GNMM starts, polish) [s].
+  double time_coarse_s = 0.0;     ///< of which the coarse stage (the GNMM starts) [s].
   double time_refine_s = 0.0;     ///< of which the refine stage [s].
   int evaluations_refine = 0;     ///< of `evaluations`, those of the refine stage.
   std::string message;            ///< human-readable summary or reason of failure.
@@ -132,10 +123,6 @@ class CubeRegistration {
   void setReference(const PointArray& reference);
   bool hasReference() const;
   const CubeGrid& grid() const;
-  /// The fine grids of the refine stage (none when refine is off).
-  const std::vector<CubeGrid>& fineGrids() const;
-  /// The shifted E grids of the refine stage's coarse term (k = 1..coarse_grids-1).
-  const std::vector<CubeGrid>& shiftedCoarseGrids() const;
 
   /// Registers `scan` to the reference around `guess` (scan -> reference). Calls on one
   /// instance are serialised (they share the per-thread working copies of the grids).
@@ -155,7 +142,7 @@ class CubeRegistration {
   struct Workspace;  // one thread's objectives (working copies) on those grids
 
   /// The coarse stage: settings_.search.starts GNMM runs from `guess` on the workspaces'
-  /// coarse objectives, then the polish runs. Counts of all runs are summed into the result.
+  /// coarse objectives. Counts of all runs are summed into the result.
   GnmmResult coarseSearch(const Pose6& guess, std::vector<Vector6d>* candidates) const;
   /// The refine stage from `candidates` on `points`; returns the best pose and its value.
   void refine(const PointArray& points, std::vector<Vector6d> candidates,
