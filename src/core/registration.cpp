@@ -17,8 +17,11 @@ namespace cube_scan_matcher {
 RegistrationSettings RegistrationSettings::paper(double cube_edge) {
   RegistrationSettings s;
   s.grid.cube_edge = cube_edge;
-  s.gnmm = GnmmSettings{};
+  s.gnmm.max_iterations = 500;
+  s.search.starts = 1;
+  s.search.threads = 1;
   s.collapse_fraction = 0.0;
+  s.refine.enabled = false;
   return s;
 }
 

@@ -17,7 +17,6 @@
 
 #include "cloud_io.h"
 #include "cube_scan_matcher/core/filters.h"
-#include "cube_scan_matcher/core/defaults.h"
 #include "cube_scan_matcher/core/registration.h"
 #include "dataset.h"
 #include "peer_methods.h"
@@ -96,7 +95,7 @@ struct Bounds {
 
 int main(int argc, char** argv) {
   std::vector<std::string> args(argv + 1, argv + argc);
-  RegistrationSettings cube_settings = defaultSettings();
+  RegistrationSettings cube_settings = RegistrationSettings{};
   RangeFilterSettings filter;
   std::string dir, csv_path = "benchmark.csv";
   int trials = 25, require = -1;

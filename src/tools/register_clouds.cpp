@@ -7,7 +7,6 @@
 
 #include "cloud_io.h"
 #include "cube_scan_matcher/core/filters.h"
-#include "cube_scan_matcher/core/defaults.h"
 #include "cube_scan_matcher/core/registration.h"
 #include "settings_cli.h"
 
@@ -26,7 +25,7 @@ void usage(std::ostream& os) {
 
 int main(int argc, char** argv) {
   std::vector<std::string> args(argv + 1, argv + argc);
-  RegistrationSettings settings = defaultSettings();
+  RegistrationSettings settings = RegistrationSettings{};
   RangeFilterSettings filter;
   Pose6 guess = Pose6::Zero();
   std::vector<std::string> files;

@@ -3,12 +3,11 @@
 #include <cstdlib>
 #include <stdexcept>
 
-#include "cube_scan_matcher/core/defaults.h"
 
 namespace cube_scan_matcher::tools {
 
 std::string algorithmOptionsHelp() {
-  const RegistrationSettings d = defaultSettings();
+  const RegistrationSettings d = RegistrationSettings{};
   const RangeFilterSettings f;
   auto num = [](double v) {
     std::string s = std::to_string(v);

@@ -9,7 +9,6 @@
 #include <string>
 #include <vector>
 
-#include "cube_scan_matcher/core/defaults.h"
 #include "cube_scan_matcher/core/registration.h"
 #include "cube_scan_matcher/sim/motion.h"
 #include "cube_scan_matcher/sim/tilting_scanner.h"
@@ -24,7 +23,7 @@ int main(int argc, char** argv) {
   int sweeps = 6;
   std::string odometry_error = "small";
   std::uint64_t seed = 1;
-  RegistrationSettings settings = defaultSettings();
+  RegistrationSettings settings = RegistrationSettings{};
   RangeFilterSettings filter;
   try {
     for (std::size_t i = 0; i < args.size();) {

@@ -10,8 +10,10 @@ namespace {
 const Vector6d kOptimum = (Vector6d() << 0.7, -0.4, 0.2, 0.1, -0.05, 0.12).finished();
 Vector6d distantStart() { return kOptimum + (Vector6d() << 0.8, -0.7, 0.6, -0.12, 0.1, -0.13).finished(); }
 
+// The paper's GNMM (15 vertices, 500 iterations) with the given restart half-widths.
 GnmmSettings bounds(double t, double a) {
   GnmmSettings s;
+  s.max_iterations = 500;
   s.bounds << t, t, t, a, a, a;
   return s;
 }

@@ -9,7 +9,6 @@
 #include <thread>
 #include <vector>
 
-#include "cube_scan_matcher/core/defaults.h"
 #include "cube_scan_matcher/core/registration.h"
 #include "cube_scan_matcher/sim/tilting_scanner.h"
 
@@ -65,7 +64,7 @@ TEST_P(SyntheticRegistration, RecoversKnownTransformFromBigInitialErrors) {
   const Eigen::Isometry3d truth = c.reverse ? s.T_first_second.inverse() : s.T_first_second;
   ASSERT_GT(scan.size(), 20000u);
 
-  CubeRegistration reg(defaultSettings());
+  CubeRegistration reg(RegistrationSettings{});
   reg.setReference(ref);
   std::mt19937_64 rng(5);
   std::uniform_real_distribution<double> u(-1.0, 1.0);
@@ -120,7 +119,7 @@ TEST(Registration, PaperModeAlsoConverges) {
 }
 
 TEST(Registration, BadInputsGiveAResultThatSaysSo) {
-  CubeRegistration reg(defaultSettings());
+  CubeRegistration reg(RegistrationSettings{});
   PointArray scan;
   scan.push_back(1, 2, 3);
   EXPECT_EQ(reg.align(scan, Pose6::Zero()).status, RegistrationStatus::NoReference);
@@ -138,7 +137,7 @@ TEST(Registration, BadInputsGiveAResultThatSaysSo) {
 }
 
 TEST(Registration, FailedReferenceKeepsThePreviousOne) {
-  CubeRegistration reg(defaultSettings());
+  CubeRegistration reg(RegistrationSettings{});
   PointArray ref;
   for (int i = 0; i < 100; ++i) ref.push_back(float(i % 10), float(i / 10), 0.f);
   reg.setReference(ref);
@@ -157,13 +156,13 @@ TEST(Registration, AReusedMatcherGivesTheResultsOfAFreshOne) {
   Pose6 guess_a = isometryToPose(a.T_first_second), guess_b = isometryToPose(b.T_first_second);
   guess_a[0] += 0.4;
   guess_b[5] += deg2rad(3);
-  CubeRegistration reused(defaultSettings());
+  CubeRegistration reused(RegistrationSettings{});
   reused.setReference(b.first);
   const RegistrationResult rb = reused.align(b.second, guess_b);
   reused.setReference(a.first);
   const RegistrationResult ra = reused.align(a.second, guess_a);
   for (int k = 0; k < 2; ++k) {
-    CubeRegistration fresh(defaultSettings());
+    CubeRegistration fresh(RegistrationSettings{});
     fresh.setReference(k ? b.first : a.first);
     const RegistrationResult f = fresh.align(k ? b.second : a.second, k ? guess_b : guess_a);
     const RegistrationResult& r = k ? rb : ra;
@@ -178,7 +177,7 @@ TEST(Registration, ConcurrentAlignCallsGiveTheSequentialResults) {
   // align() shares the per-thread working copies, so calls on one instance are serialised:
   // two callers at once must get exactly what one caller gets.
   const Scans s = makeScans(sim::SceneType::Urban, 3);
-  CubeRegistration reg(defaultSettings());
+  CubeRegistration reg(RegistrationSettings{});
   reg.setReference(s.first);
   Pose6 g1 = isometryToPose(s.T_first_second), g2 = g1;
   g1[0] += 0.5;
@@ -196,10 +195,10 @@ TEST(Registration, ConcurrentAlignCallsGiveTheSequentialResults) {
 }
 
 TEST(Registration, SettingsAreValidated) {
-  RegistrationSettings s = defaultSettings();
+  RegistrationSettings s = RegistrationSettings{};
   s.collapse_fraction = 2.0;
   EXPECT_THROW(CubeRegistration{s}, std::invalid_argument);
-  s = defaultSettings();
+  s = RegistrationSettings{};
   s.refine.enabled = true;
   s.refine.edge_fraction = 1.5;
   EXPECT_THROW(CubeRegistration{s}, std::invalid_argument);

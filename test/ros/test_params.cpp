@@ -1,5 +1,5 @@
 // The defaults of cfg/ScanMatcher.cfg (dynamic_reconfigure) must equal the C++ defaults
-// (core/defaults.h via NodeParams), so the cfg, the YAML, the README and the code agree.
+// (RegistrationSettings{} via NodeParams), so the cfg, the YAML, the README and the code agree.
 #include <gtest/gtest.h>
 
 #include "cube_scan_matcher/ros/params.h"

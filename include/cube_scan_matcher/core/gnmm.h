@@ -16,7 +16,9 @@ using Vector6d = Eigen::Matrix<double, 6, 1>;
 
 struct GnmmSettings {
   int vertices = 15;          ///< N, population size, in [7, 1000] (paper: 15).
-  int max_iterations = 500;   ///< Nelder-Mead iterations, in [1, 1e6] (paper: 500).
+  /// Nelder-Mead iterations, in [1, 1e6]. The paper runs 500; the package's multi-start
+  /// coarse stage runs 300 per start (RegistrationSettings::paper() sets 500).
+  int max_iterations = 300;
   /// Restart half-widths around the initial estimate, per parameter, all > 0. For poses:
   /// [m, m, m, rad, rad, rad]; the paper's default is +-1 m, +-8 deg.
   Vector6d bounds = (Vector6d() << 1.0, 1.0, 1.0, 0.13962634015954636, 0.13962634015954636,

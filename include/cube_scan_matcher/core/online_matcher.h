@@ -10,13 +10,12 @@
 #include <Eigen/Geometry>
 
 #include "cube_scan_matcher/core/acceptance_gate.h"
-#include "cube_scan_matcher/core/defaults.h"
 #include "cube_scan_matcher/core/registration.h"
 
 namespace cube_scan_matcher {
 
 struct OnlineMatcherSettings {
-  RegistrationSettings registration = defaultSettings();
+  RegistrationSettings registration;
   GateSettings gate;
   /// After this many consecutive rejected scans the step reports `rejection_alarm`. >= 1.
   int max_consecutive_rejections = 5;

@@ -19,20 +19,24 @@
 
 namespace cube_scan_matcher {
 
+// The defaults below are the package's shipped mode (beyond the paper; each choice measured in
+// BENCHMARK.md): RegistrationSettings{} is what the tools, the nodelet and the README call
+// "default", and RegistrationSettings::paper() is the paper's fixed mode.
+
 /// Beyond the paper: a local search on a finer grid from the result of the coarse stage. The
 /// coarse cubes give the wide basin of convergence, the fine cubes the accuracy.
 struct RefineSettings {
-  bool enabled = false;
+  bool enabled = true;         ///< off in the paper's mode.
   double edge_fraction = 0.5;  ///< fine edge = edge_fraction * E, in (0, 1).
   /// Fine grids with origins shifted by k/grids of a fine cube, k = 0..grids-1; the refine
   /// objective is the sum of their J (anti-aliasing). In [1, 8].
-  int grids = 1;
+  int grids = 3;
   /// Weight of J on the coarse grid (edge E) added to the fine grids' sum; 0 = fine grids
   /// only. In [0, 100].
-  double coarse_weight = 0.0;
-  /// Distinct coarse results (of the independent starts, by decreasing J) refined; the highest
-  /// fine J wins. In [1, 64].
-  int candidates = 1;
+  double coarse_weight = 3.0;
+  /// Distinct coarse results (of the independent starts, by decreasing J) refined, one per
+  /// thread; the highest refine objective wins. In [1, 64].
+  int candidates = 2;
   /// Two coarse results are one candidate when their translations differ by at most
   /// distinct_translation [m] and each angle by at most distinct_rotation [rad]; both > 0.
   double distinct_translation = 0.1;
@@ -52,24 +56,30 @@ struct RefineSettings {
 /// from the initial estimate (starts = 1).
 struct SearchSettings {
   /// Independent GNMM searches from the initial estimate, seeds gnmm.seed + k; the highest J
-  /// wins (ties: lowest k). In [1, 64].
-  int starts = 1;
-  /// Threads the starts (and the refine candidates) run on, in rounds of `threads`; each
-  /// thread owns a working copy of every grid. In [1, 64].
-  int threads = 1;
+  /// wins (ties: lowest k). One GNMM from +-1 m/+-8 deg lands in a wrong local maximum in a
+  /// part of the trials, four rarely all do. In [1, 64].
+  int starts = 4;
+  /// Threads the starts (and the refine candidates and the grid builds) run on; start k runs
+  /// on thread k % threads, and each thread owns a working copy of every grid. In [1, 64].
+  int threads = 2;
 };
 
+/// Shipped mode: the coarse stage at E = 0.5 m on the scan collapsed to one point per E/4
+/// voxel, four GNMM starts of 300 iterations (15 vertices, restarts within +-1 m/+-8 deg), two
+/// at a time; the refine stage climbs the sum of J over three E/2 grids plus 3 x J on the E
+/// grid from the two best distinct coarse results. Working copies of grids up to 2^22 cubes use
+/// a byte per cube.
 struct RegistrationSettings {
-  CubeGridSettings grid;  ///< E and the memory cap.
+  CubeGridSettings grid;  ///< E and the memory caps.
   GnmmSettings gnmm;      ///< population, iterations, restart bounds, seed.
   SearchSettings search;  ///< starts and threads of the coarse stage.
-  RefineSettings refine;  ///< optional fine stage (off in the paper's mode).
+  RefineSettings refine;  ///< the fine stage (off in the paper's mode).
   /// Beyond the paper: before the search, keep one scan point per voxel of edge
   /// collapse_fraction * E. 0 = off, every point is evaluated (paper). In [0, 1].
-  double collapse_fraction = 0.0;
+  double collapse_fraction = 0.25;
 
-  /// The paper's fixed mode: 15 vertices, 500 iterations, all points, restarts around the
-  /// initial estimate within +-1 m / +-8 deg.
+  /// The paper's fixed mode: one GNMM of 15 vertices and 500 iterations on all points,
+  /// restarts around the initial estimate within +-1 m / +-8 deg, no refine stage.
   static RegistrationSettings paper(double cube_edge = 0.5);
 };
 
