@@ -15,7 +15,7 @@ void validate(const CompassSettings& s) {
                                 std::to_string(s.max_evaluations));
 }
 
-CompassResult compassMaximize(const std::function<double(const Vector6d&)>& f,
+CompassResult compassMaximize(const Objective6& f,
                               const Vector6d& initial, const CompassSettings& s) {
   validate(s);
   CompassResult r;

@@ -4,6 +4,7 @@
 #include <cmath>
 #include <random>
 #include <stdexcept>
+#include <string>
 #include <vector>
 
 namespace cube_scan_matcher {
@@ -23,7 +24,7 @@ void validate(const GnmmSettings& s) {
 
 Gnmm::Gnmm(const GnmmSettings& settings) : settings_(settings) { validate(settings_); }
 
-GnmmResult Gnmm::maximize(const Objective& f, const Vector6d& initial) const {
+GnmmResult Gnmm::maximize(const Objective6& f, const Vector6d& initial) const {
   const GnmmSettings& s = settings_;
   const int n = s.vertices;
   std::mt19937_64 rng(s.seed);

@@ -3,9 +3,7 @@
 // result, where GNMM's random population rarely beats its best vertex in a small box.
 #pragma once
 
-#include <functional>
-
-#include "cube_scan_matcher/core/gnmm.h"
+#include "cube_scan_matcher/core/vector6.h"
 
 namespace cube_scan_matcher {
 
@@ -30,7 +28,7 @@ struct CompassResult {
 
 /// At each level, try +-step along each of the 6 axes from the current point, move to any
 /// strictly better point at once and repeat until no axis improves; then halve the steps.
-CompassResult compassMaximize(const std::function<double(const Vector6d&)>& f,
+CompassResult compassMaximize(const Objective6& f,
                               const Vector6d& initial, const CompassSettings& settings);
 
 }  // namespace cube_scan_matcher

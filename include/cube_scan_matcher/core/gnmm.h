@@ -5,14 +5,10 @@
 #pragma once
 
 #include <cstdint>
-#include <functional>
-#include <string>
 
-#include <Eigen/Core>
+#include "cube_scan_matcher/core/vector6.h"
 
 namespace cube_scan_matcher {
-
-using Vector6d = Eigen::Matrix<double, 6, 1>;
 
 struct GnmmSettings {
   int vertices = 15;          ///< N, population size, in [7, 1000] (paper: 15).
@@ -43,13 +39,11 @@ struct GnmmResult {
 
 class Gnmm {
  public:
-  using Objective = std::function<double(const Vector6d&)>;
-
   explicit Gnmm(const GnmmSettings& settings);  // validates
 
   /// Maximises f starting from `initial`. The population is the initial estimate plus N-1
   /// vertices drawn uniformly within +-bounds around it.
-  GnmmResult maximize(const Objective& f, const Vector6d& initial) const;
+  GnmmResult maximize(const Objective6& f, const Vector6d& initial) const;
 
  private:
   GnmmSettings settings_;

@@ -10,59 +10,19 @@
 
 #include <Eigen/Geometry>
 
-#include "cube_scan_matcher/core/coincidence_objective.h"
-#include "cube_scan_matcher/core/compass_search.h"
+#include "cube_scan_matcher/core/coarse_search.h"
 #include "cube_scan_matcher/core/cube_grid.h"
 #include "cube_scan_matcher/core/gnmm.h"
 #include "cube_scan_matcher/core/point_array.h"
 #include "cube_scan_matcher/core/pose.h"
+#include "cube_scan_matcher/core/reference_grids.h"
+#include "cube_scan_matcher/core/refine_search.h"
 
 namespace cube_scan_matcher {
 
-// The defaults below are the package's shipped mode (beyond the paper; each choice measured in
-// BENCHMARK.md): RegistrationSettings{} is what the tools, the nodelet and the README call
-// "default", and RegistrationSettings::paper() is the paper's fixed mode.
-
-/// Beyond the paper: a local search on a finer grid from the result of the coarse stage. The
-/// coarse cubes give the wide basin of convergence, the fine cubes the accuracy.
-struct RefineSettings {
-  bool enabled = true;         ///< off in the paper's mode.
-  double edge_fraction = 0.5;  ///< fine edge = edge_fraction * E, in (0, 1).
-  /// Fine grids with origins shifted by k/grids of a fine cube, k = 0..grids-1; the refine
-  /// objective is the sum of their J (anti-aliasing). In [1, 8].
-  int grids = 3;
-  /// Weight of J on the coarse grid (edge E) added to the fine grids' sum; 0 = fine grids
-  /// only. In [0, 100].
-  double coarse_weight = 3.0;
-  /// Distinct coarse results (of the independent starts, by decreasing J) refined, one per
-  /// thread; the highest refine objective wins. In [1, 64].
-  int candidates = 2;
-  /// Two coarse results are one candidate when their translations differ by at most
-  /// distinct_translation [m] and each angle by at most distinct_rotation [rad]; both > 0.
-  double distinct_translation = 0.1;
-  double distinct_rotation = 0.017453292519943295;  // 1 deg
-  /// The refine stage evaluates the scan collapsed to one point per voxel of this * E (the
-  /// coarse stage uses RegistrationSettings::collapse_fraction). 0 = all points. In [0, 1].
-  double collapse_fraction = 0.25;
-  /// Rotations of the compass search pivot about the centroid of the scan points instead of
-  /// the scan origin, so that a rotation step does not also move far points sideways: pitch
-  /// and z (yaw and y, ...) decouple. The result is the same pose parametrisation (eq. 2).
-  bool centroid_pivot = true;
-  /// Compass search on the fine objective: first steps 0.125 m / 1 deg, halved 5 times.
-  CompassSettings compass;
-};
-
-/// Beyond the paper: how the coarse stage spends its evaluations. The paper runs one GNMM
-/// from the initial estimate (starts = 1).
-struct SearchSettings {
-  /// Independent GNMM searches from the initial estimate, seeds gnmm.seed + k; the highest J
-  /// wins (ties: lowest k). One GNMM from +-1 m/+-8 deg lands in a wrong local maximum in a
-  /// part of the trials, four rarely all do. In [1, 64].
-  int starts = 4;
-  /// Threads the starts (and the refine candidates and the grid builds) run on; start k runs
-  /// on thread k % threads, and each thread owns a working copy of every grid. In [1, 64].
-  int threads = 2;
-};
+// The defaults of the settings structs are the package's shipped mode (beyond the paper; each
+// choice measured in BENCHMARK.md): RegistrationSettings{} is what the tools, the nodelet and
+// the README call "default", and RegistrationSettings::paper() is the paper's fixed mode.
 
 /// Shipped mode: the coarse stage at E = 0.5 m on the scan collapsed to one point per E/4
 /// voxel, four GNMM starts of 300 iterations (15 vertices, restarts within +-1 m/+-8 deg), two
@@ -148,25 +108,22 @@ class CubeRegistration {
   void setSettings(const RegistrationSettings& settings);
 
  private:
-  struct Reference;  // the grids of the reference scan
-  struct Workspace;  // one thread's objectives (working copies) on those grids
+  struct ScanPoints;  // the points each stage evaluates
 
-  /// The coarse stage: settings_.search.starts GNMM runs from `guess` on the workspaces'
-  /// coarse objectives. Counts of all runs are summed into the result.
-  GnmmResult coarseSearch(const Pose6& guess, std::vector<Vector6d>* candidates) const;
-  /// The refine stage from `candidates` on `points`; returns the best pose and its value.
-  void refine(const PointArray& points, std::vector<Vector6d> candidates,
-              RegistrationResult& res) const;
   /// Makes `count` workspaces on the current reference (reusing existing ones).
   void prepareWorkspaces(int count) const;
-
-  /// The points the objective evaluates: `scan` itself, or its collapsed copy in `storage`.
-  const PointArray& prepareScan(const PointArray& scan, PointArray& storage,
-                                double fraction) const;
+  /// The steps of align(), under the mutex.
+  void prepareScan(const PointArray& scan, ScanPoints& points) const;
+  void coarseStage(const ScanPoints& points, const Pose6& guess, RegistrationResult& res,
+                   std::vector<Pose6>& ranked) const;
+  void refineStage(const ScanPoints& points, const std::vector<Pose6>& ranked,
+                   RegistrationResult& res) const;
+  /// Unbinds every objective from this call's points.
+  void releaseScan() const;
 
   RegistrationSettings settings_;
-  std::unique_ptr<Reference> reference_;  // stable address: the workspaces point into it
-  mutable std::vector<std::unique_ptr<Workspace>> workspaces_;
+  std::unique_ptr<ReferenceGrids> reference_;  // stable address: the workspaces point into it
+  mutable std::vector<std::unique_ptr<GridWorkspace>> workspaces_;  // one per thread
   mutable std::unique_ptr<std::mutex> mutex_;  // serialises align() and score()
 };
 

@@ -1,0 +1,45 @@
+// The coarse stage (paper section 2.3, beyond it in the number of starts): independent GNMM
+// searches for the maximum of J on the E grid from the initial estimate.
+#pragma once
+
+#include <vector>
+
+#include "cube_scan_matcher/core/coincidence_objective.h"
+#include "cube_scan_matcher/core/gnmm.h"
+#include "cube_scan_matcher/core/pose.h"
+
+namespace cube_scan_matcher {
+
+/// Beyond the paper: how the coarse stage spends its evaluations. The paper runs one GNMM
+/// from the initial estimate (starts = 1).
+struct SearchSettings {
+  /// Independent GNMM searches from the initial estimate, seeds gnmm.seed + k; the highest J
+  /// wins (ties: lowest k). One GNMM from +-1 m/+-8 deg lands in a wrong local maximum in a
+  /// part of the trials, four rarely all do. In [1, 64].
+  int starts = 4;
+  /// Threads the starts (and the refine candidates and the grid builds) run on; start k runs
+  /// on thread k % threads, and each thread owns a working copy of every grid. In [1, 64].
+  int threads = 2;
+};
+
+/// Throws std::invalid_argument naming the bad setting.
+void validate(const SearchSettings& settings);
+
+struct CoarseSearchResult {
+  /// One GNMM result per start, by decreasing J (ties: lowest start first): runs[0] wins.
+  std::vector<GnmmResult> runs;
+  int J_guess = 0;      ///< J at the initial estimate.
+  int evaluations = 0;  ///< summed over the starts.
+  int iterations = 0;   ///< summed over the starts.
+  int restarts = 0;     ///< summed over the starts.
+};
+
+/// Runs search.starts GNMM searches (gnmm settings, seed gnmm.seed + k for start k) from
+/// `guess`, start k on thread k % search.threads with objectives[thread] (each thread's own
+/// working copy of the E grid, bound to the same scan). Needs
+/// objectives.size() >= min(search.threads, search.starts).
+CoarseSearchResult coarseSearch(const std::vector<CoincidenceObjective*>& objectives,
+                                const GnmmSettings& gnmm, const SearchSettings& search,
+                                const Pose6& guess);
+
+}  // namespace cube_scan_matcher

@@ -1,0 +1,43 @@
+// The grids of one reference scan (the E grid of the coarse stage and the refine stage's fine
+// grids) and one thread's working copies of them (GridWorkspace), which outlive a registration.
+#pragma once
+
+#include <vector>
+
+#include "cube_scan_matcher/core/coincidence_objective.h"
+#include "cube_scan_matcher/core/cube_grid.h"
+#include "cube_scan_matcher/core/point_array.h"
+#include "cube_scan_matcher/core/refine_search.h"
+
+namespace cube_scan_matcher {
+
+struct ReferenceGrids {
+  CubeGrid coarse;             ///< edge E: the coarse stage (and the refine's coarse term).
+  std::vector<CubeGrid> fine;  ///< edge edge_fraction * E, origins shifted by k/grids.
+};
+
+/// Builds the E grid and, when refine.enabled, the refine.grids fine grids of `reference`, on
+/// `threads` threads. Throws the first CubeGridError (then nothing is returned).
+ReferenceGrids buildReferenceGrids(const PointArray& reference, const CubeGridSettings& grid,
+                                   const RefineSettings& refine, int threads);
+
+/// One thread's objectives: a working copy of every grid of a ReferenceGrids. Moving it to
+/// other grids (retarget) reuses its memory instead of allocating it again.
+class GridWorkspace {
+ public:
+  explicit GridWorkspace(const ReferenceGrids& grids);
+  /// Moves every objective to `grids` (no-op when already on them). The previous grids must
+  /// still be alive during this call. Unbinds the scans.
+  void retarget(const ReferenceGrids& grids);
+  /// Binds the E-grid objective to `coarse_points` and the fine ones to `fine_points`.
+  void setScan(const PointArray& coarse_points, const PointArray& fine_points);
+
+  CoincidenceObjective coarse;
+  std::vector<CoincidenceObjective> fine;
+
+ private:
+  void retargetFine(const ReferenceGrids& grids);
+  const ReferenceGrids* target_ = nullptr;
+};
+
+}  // namespace cube_scan_matcher

@@ -1,0 +1,64 @@
+#include "cube_scan_matcher/core/reference_grids.h"
+
+#include <exception>
+
+#include "cube_scan_matcher/core/parallel.h"
+
+namespace cube_scan_matcher {
+
+ReferenceGrids buildReferenceGrids(const PointArray& reference, const CubeGridSettings& grid,
+                                   const RefineSettings& refine, int threads) {
+  // specs[0] is the E grid, the rest are the fine grids.
+  std::vector<CubeGridSettings> specs{grid};
+  if (refine.enabled) {
+    CubeGridSettings gs = grid;
+    gs.cube_edge *= refine.edge_fraction;
+    for (int k = 0; k < refine.grids; ++k) {
+      gs.origin_shift = double(k) / refine.grids;
+      specs.push_back(gs);
+    }
+  }
+  std::vector<CubeGrid> grids(specs.size());
+  std::vector<std::exception_ptr> errors(specs.size());
+  runOnThreads(int(specs.size()), threads, [&](int k, int) {
+    try {
+      grids[std::size_t(k)] = CubeGrid::build(reference, specs[std::size_t(k)]);
+    } catch (...) {
+      errors[std::size_t(k)] = std::current_exception();
+    }
+  });
+  for (const std::exception_ptr& e : errors) {
+    if (e) std::rethrow_exception(e);
+  }
+  ReferenceGrids r;
+  r.coarse = std::move(grids[0]);
+  for (std::size_t k = 1; k < specs.size(); ++k) r.fine.push_back(std::move(grids[k]));
+  return r;
+}
+
+GridWorkspace::GridWorkspace(const ReferenceGrids& grids) : coarse(grids.coarse) {
+  retargetFine(grids);
+  target_ = &grids;
+}
+
+void GridWorkspace::retarget(const ReferenceGrids& grids) {
+  if (target_ == &grids) return;
+  coarse.setGrid(grids.coarse);
+  retargetFine(grids);
+  target_ = &grids;
+}
+
+void GridWorkspace::setScan(const PointArray& coarse_points, const PointArray& fine_points) {
+  coarse.setScan(coarse_points);
+  for (CoincidenceObjective& j : fine) j.setScan(fine_points);
+}
+
+void GridWorkspace::retargetFine(const ReferenceGrids& grids) {
+  if (fine.size() > grids.fine.size()) {
+    fine.erase(fine.begin() + std::ptrdiff_t(grids.fine.size()), fine.end());
+  }
+  for (std::size_t k = 0; k < fine.size(); ++k) fine[k].setGrid(grids.fine[k]);
+  for (std::size_t k = fine.size(); k < grids.fine.size(); ++k) fine.emplace_back(grids.fine[k]);
+}
+
+}  // namespace cube_scan_matcher
