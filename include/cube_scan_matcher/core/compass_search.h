@@ -11,7 +11,9 @@ struct CompassSettings {
   /// First step per parameter, all > 0. For poses [m, m, m, rad, rad, rad].
   Vector6d initial_step = (Vector6d() << 0.125, 0.125, 0.125, 0.017453292519943295,
                            0.017453292519943295, 0.017453292519943295).finished();
-  int levels = 5;                 ///< step halvings, in [1, 30]: last step = initial / 2^(levels-1).
+  /// Step sizes tried, in [1, 30]: the first step, then levels - 1 halvings (last step =
+  /// initial / 2^(levels-1)).
+  int levels = 5;
   int max_evaluations = 2000;     ///< hard budget, in [1, 1e7].
 };
 
