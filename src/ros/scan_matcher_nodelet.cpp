@@ -150,102 +150,128 @@ void ScanMatcherNodelet::cloudCallback(const sensor_msgs::PointCloud2ConstPtr& m
   }
 }
 
+// processCloud's steps. Each returns false (after publishing the status) when the scan stops
+// there; a scan that stops keeps the reference and the pose chain as they were.
 void ScanMatcherNodelet::processCloud(const sensor_msgs::PointCloud2& msg, double received) {
-  const ros::Time stamp = msg.header.stamp;
   Status status;
-  status.header.stamp = stamp;
+  status.header.stamp = msg.header.stamp;
   status.header.frame_id = params_.map_frame;
   status.points_in = msg.width * msg.height;
-  auto publishStatus = [&](GateReason reason, const std::string& message) {
-    status.reason = std::uint8_t(reason);
-    status.reason_text = toString(reason);
-    status.accepted = reason == GateReason::Accepted;
-    status.message = message;
-    status.rejected_scans = rejected_;
-    status.tf_failures = tf_failures_;
-    status.dropped_scans = dropped_;
-    status.consecutive_rejections = consecutive_rejections_;
-    status.latency = ros::WallTime::now().toSec() - received;
-    latencies_.push_back(status.latency);
-    if (latencies_.size() > 200) latencies_.pop_front();
-    status_pub_.publish(status);
-  };
+  Scan scan(msg, received, status);
 
-  if (stamp.isZero()) {
-    ++bad_input_;
-    NODELET_ERROR_THROTTLE(5.0, "cloud %u has a zero stamp; tf cannot be looked up at it",
-                           msg.header.seq);
-    publishStatus(GateReason::BadInput, "cloud has a zero stamp");
-    return;
+  if (!checkHeader(scan)) return;
+  trackStamps(scan);
+  if (!lookupFrames(scan)) return;
+  if (!convertPoints(scan)) return;
+  const OnlineStep step = registerScan(scan);
+  publishPose(scan, step);
+  publishStatus(scan, step.reason, step.message);
+}
+
+void ScanMatcherNodelet::rejectInput(Scan& scan, const std::string& why) {
+  ++bad_input_;
+  NODELET_ERROR_THROTTLE(5.0, "cloud %u not used: %s", scan.msg.header.seq, why.c_str());
+  publishStatus(scan, GateReason::BadInput, why);
+}
+
+void ScanMatcherNodelet::publishStatus(Scan& scan, GateReason reason,
+                                       const std::string& message) {
+  Status& status = scan.status;
+  status.reason = std::uint8_t(reason);
+  status.reason_text = toString(reason);
+  status.accepted = reason == GateReason::Accepted;
+  status.message = message;
+  status.rejected_scans = rejected_;
+  status.tf_failures = tf_failures_;
+  status.dropped_scans = dropped_;
+  status.consecutive_rejections = consecutive_rejections_;
+  status.latency = ros::WallTime::now().toSec() - scan.received;
+  latencies_.push_back(status.latency);
+  if (latencies_.size() > 200) latencies_.pop_front();
+  status_pub_.publish(status);
+}
+
+bool ScanMatcherNodelet::checkHeader(Scan& scan) {
+  if (scan.msg.header.stamp.isZero()) {
+    rejectInput(scan, "cloud has a zero stamp; tf cannot be looked up at it");
+    return false;
   }
+  if (scan.msg.header.frame_id.empty()) {
+    rejectInput(scan, "cloud has an empty frame_id");
+    return false;
+  }
+  return true;
+}
+
+void ScanMatcherNodelet::trackStamps(Scan& scan) {
+  const ros::Time stamp = scan.msg.header.stamp;
   // Time going backwards: a looping bag or a reset clock. One warning, then a fresh start.
   if (last_stamp_ && stamp < *last_stamp_) {
     std::ostringstream os;
-    os << std::fixed << std::setprecision(3) << "time went backwards from " << last_stamp_->toSec() << " s to " << stamp.toSec()
-       << " s (bag loop or clock reset)";
+    os << std::fixed << std::setprecision(3) << "time went backwards from "
+       << last_stamp_->toSec() << " s to " << stamp.toSec() << " s (bag loop or clock reset)";
     resetState(os.str());
     tf_buffer_->clear();
-    status.time_reset = true;
+    scan.status.time_reset = true;
   }
-  if (last_seq_ && msg.header.seq > *last_seq_ + 1) dropped_ += msg.header.seq - *last_seq_ - 1;
-  last_seq_ = msg.header.seq;
+  const std::uint32_t seq = scan.msg.header.seq;
+  if (last_seq_ && seq > *last_seq_ + 1) dropped_ += seq - *last_seq_ - 1;
+  last_seq_ = seq;
   last_stamp_ = stamp;
+}
 
+bool ScanMatcherNodelet::lookupFrames(Scan& scan) {
   // The cloud in base_frame at its stamp, and the odometry pose there.
+  const ros::Time stamp = scan.msg.header.stamp;
+  const std::string& frame = scan.msg.header.frame_id;
   std::string tf_error;
-  std::optional<Eigen::Isometry3d> T_base_cloud;
-  if (msg.header.frame_id.empty()) {
-    ++bad_input_;
-    NODELET_ERROR_THROTTLE(5.0, "cloud %u has an empty frame_id", msg.header.seq);
-    publishStatus(GateReason::BadInput, "cloud has an empty frame_id");
-    return;
-  }
-  if (msg.header.frame_id == params_.base_frame) {
-    T_base_cloud = Eigen::Isometry3d::Identity();
-  } else {
-    T_base_cloud = lookup(params_.base_frame, msg.header.frame_id, stamp, tf_error);
-  }
-  const std::optional<Eigen::Isometry3d> odom =
-      lookup(params_.odom_frame, params_.base_frame, stamp, tf_error);
-  status.tf_failed = !T_base_cloud || !odom;
-  if (status.tf_failed) {
+  std::optional<Eigen::Isometry3d> T_base_cloud =
+      frame == params_.base_frame ? std::optional<Eigen::Isometry3d>(Eigen::Isometry3d::Identity())
+                                  : lookup(params_.base_frame, frame, stamp, tf_error);
+  scan.odom = lookup(params_.odom_frame, params_.base_frame, stamp, tf_error);
+  scan.status.tf_failed = !T_base_cloud || !scan.odom;
+  if (scan.status.tf_failed) {
     ++tf_failures_;
     NODELET_WARN_THROTTLE(5.0, "tf missing for scan at %.3f s within %.2f s: %s", stamp.toSec(),
                           params_.tf_timeout, tf_error.c_str());
   }
-  if (!T_base_cloud || (!odom && params_.skip_without_tf)) {
-    publishStatus(GateReason::SkippedNoTf,
+  if (!T_base_cloud || (!scan.odom && params_.skip_without_tf)) {
+    publishStatus(scan, GateReason::SkippedNoTf,
                   (T_base_cloud ? "odometry tf missing, missing_tf_policy = skip: "
                                 : "cloud frame cannot be brought into base_frame: ") +
                       tf_error);
-    return;
+    return false;
   }
+  scan.T_base_cloud = *T_base_cloud;
+  return true;
+}
 
+bool ScanMatcherNodelet::convertPoints(Scan& scan) {
   FilterStats fs;
-  PointArray points;
   try {
-    points = filterPoints(fromCloud(msg, *T_base_cloud), params_.filter, &fs);
+    scan.points = filterPoints(fromCloud(scan.msg, scan.T_base_cloud), params_.filter, &fs);
   } catch (const CloudError& e) {
-    ++bad_input_;
-    NODELET_ERROR_THROTTLE(5.0, "cloud %u rejected: %s", msg.header.seq, e.what());
-    publishStatus(GateReason::BadInput, e.what());
-    return;
+    rejectInput(scan, e.what());
+    return false;
   }
-  status.points_valid = std::uint32_t(points.size());
-  if (points.empty()) {
-    ++bad_input_;
+  scan.status.points_valid = std::uint32_t(scan.points.size());
+  if (scan.points.empty()) {
     std::ostringstream os;
     os << "cloud has no usable point: " << fs.input << " points, " << fs.non_finite
        << " NaN/inf, " << fs.out_of_range << " outside [min_range, max_range]";
-    NODELET_WARN_THROTTLE(5.0, "%s", os.str().c_str());
-    publishStatus(GateReason::BadInput, os.str());
-    return;
+    rejectInput(scan, os.str());
+    return false;
   }
+  return true;
+}
 
+OnlineStep ScanMatcherNodelet::registerScan(Scan& scan) {
   // Register, gate and chain (core).
-  const OnlineStep step = matcher_->process(points, stamp.toSec(), odom);
+  const OnlineStep step =
+      matcher_->process(scan.points, scan.msg.header.stamp.toSec(), scan.odom);
   ++processed_;
   const RegistrationResult& r = step.result;
+  Status& status = scan.status;
   status.J = r.J;
   status.J_guess = r.J_guess;
   status.reference_cubes = std::int32_t(r.reference_cubes);
@@ -269,15 +295,18 @@ void ScanMatcherNodelet::processCloud(const sensor_msgs::PointCloud2& msg, doubl
     NODELET_ERROR_THROTTLE(5.0, "%d scans in a row rejected (last: %s): poses follow odometry only",
                            step.consecutive_rejections, step.message.c_str());
   } else if (rejected) {
-    NODELET_WARN_THROTTLE(2.0, "scan at %.3f s rejected: %s", stamp.toSec(), step.message.c_str());
+    NODELET_WARN_THROTTLE(2.0, "scan at %.3f s rejected: %s", scan.msg.header.stamp.toSec(),
+                          step.message.c_str());
   }
+  return step;
+}
 
-  // Outputs.
+void ScanMatcherNodelet::publishPose(const Scan& scan, const OnlineStep& step) {
   const bool registered_pose = step.reason == GateReason::Accepted ||
                                step.reason == GateReason::FirstScan;
   const double scale = registered_pose ? 1.0 : params_.rejected_sigma_scale;
   std_msgs::Header header;
-  header.stamp = stamp;
+  header.stamp = scan.msg.header.stamp;
   header.frame_id = params_.map_frame;
 
   geometry_msgs::PoseWithCovarianceStamped pose;
@@ -297,7 +326,7 @@ void ScanMatcherNodelet::processCloud(const sensor_msgs::PointCloud2& msg, doubl
   geometry_msgs::PoseStamped path_pose;
   path_pose.header = header;
   path_pose.pose = pose.pose.pose;
-  path_.header.stamp = stamp;
+  path_.header.stamp = header.stamp;
   path_.poses.push_back(path_pose);
   if (path_.poses.size() > std::size_t(params_.path_max_length)) {
     path_.poses.erase(path_.poses.begin(),
@@ -305,14 +334,14 @@ void ScanMatcherNodelet::processCloud(const sensor_msgs::PointCloud2& msg, doubl
   }
   path_pub_.publish(path_);
 
-  if (cloud_pub_.getNumSubscribers() > 0) cloud_pub_.publish(toCloud(points, step.pose, header));
+  if (cloud_pub_.getNumSubscribers() > 0) cloud_pub_.publish(toCloud(scan.points, step.pose, header));
 
-  if (tf_broadcaster_ && odom) {
+  if (tf_broadcaster_ && scan.odom) {
     // REP-105: map -> odom such that map -> odom -> base_link equals the registered pose.
-    tf_broadcaster_->sendTransform(stampedTransform(step.pose * odom->inverse(), params_.map_frame,
-                                                    params_.odom_frame, stamp));
+    tf_broadcaster_->sendTransform(stampedTransform(step.pose * scan.odom->inverse(),
+                                                    params_.map_frame, params_.odom_frame,
+                                                    header.stamp));
   }
-  publishStatus(step.reason, step.message);
 }
 
 void ScanMatcherNodelet::diagnose(diagnostic_updater::DiagnosticStatusWrapper& stat) {

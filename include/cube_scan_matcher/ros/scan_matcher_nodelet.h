@@ -21,6 +21,7 @@
 #include <tf2_ros/transform_listener.h>
 
 #include "cube_scan_matcher/ScanMatcherConfig.h"
+#include "cube_scan_matcher/Status.h"
 #include "cube_scan_matcher/core/online_matcher.h"
 #include "cube_scan_matcher/ros/params.h"
 
@@ -34,8 +35,27 @@ class ScanMatcherNodelet : public nodelet::Nodelet {
  private:
   void onInit() override;
   void cloudCallback(const sensor_msgs::PointCloud2ConstPtr& msg);
-  /// The work of cloudCallback, under the state mutex; may throw.
+  /// The work of cloudCallback, under the state mutex; may throw. Its steps, in order:
   void processCloud(const sensor_msgs::PointCloud2& msg, double received_wall);
+  /// One scan on its way through processCloud.
+  struct Scan {
+    Scan(const sensor_msgs::PointCloud2& m, double r, Status& s) : msg(m), received(r), status(s) {}
+    const sensor_msgs::PointCloud2& msg;
+    double received;  ///< wall time of the callback [s]
+    Status& status;   ///< filled along the way, published at the end
+    Eigen::Isometry3d T_base_cloud = Eigen::Isometry3d::Identity();
+    std::optional<Eigen::Isometry3d> odom;  ///< T_odom_base at the stamp, if tf had it
+    PointArray points;                      ///< valid points in base_frame
+  };
+  bool checkHeader(Scan& scan);     ///< a stamp and a frame
+  void trackStamps(Scan& scan);     ///< time going backwards (reset), dropped scans
+  bool lookupFrames(Scan& scan);    ///< cloud -> base_frame and odometry at the stamp
+  bool convertPoints(Scan& scan);   ///< PointCloud2 -> filtered points in base_frame
+  OnlineStep registerScan(Scan& scan);  ///< the core: register, gate, chain
+  void publishPose(const Scan& scan, const OnlineStep& step);  ///< pose, odometry, path, cloud, tf
+  void publishStatus(Scan& scan, GateReason reason, const std::string& message);
+  /// The bad-input exit: counted, logged (throttled) and published as BAD_INPUT.
+  void rejectInput(Scan& scan, const std::string& why);
   bool resetService(std_srvs::Trigger::Request& req, std_srvs::Trigger::Response& res);
   void reconfigure(ScanMatcherConfig& config, uint32_t level);
   /// T_target_source at `stamp`, waiting at most ~tf_timeout; nullopt (and counted) on failure.
