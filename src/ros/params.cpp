@@ -3,6 +3,9 @@
 #include <cmath>
 #include <sstream>
 
+#include <boost/any.hpp>
+#include <dynamic_reconfigure/config_tools.h>
+
 #include "cube_scan_matcher/core/pose.h"
 
 namespace cube_scan_matcher {
@@ -45,6 +48,46 @@ void configToSettings(const ScanMatcherConfig& c, OnlineMatcherSettings& m) {
   m.gate.max_correction_m = c.max_correction_translation;
   m.gate.max_correction_rad = deg2rad(c.max_correction_rotation);
   m.max_consecutive_rejections = c.max_consecutive_rejections;
+}
+
+/// The unit in a cfg description ("Cube edge E [m] (paper ...)" -> "m"), or "".
+std::string unitOf(const std::string& description) {
+  const std::size_t open = description.find('['), close = description.find(']', open);
+  return open == std::string::npos || close == std::string::npos
+             ? std::string()
+             : description.substr(open + 1, close - open - 1);
+}
+
+/// Reads every parameter of cfg/ScanMatcher.cfg from ~name (default: its value in `c`) and
+/// checks it against the cfg's own [min, max]: the cfg is the one source of the live
+/// parameters' names, types and ranges.
+void readLiveParams(const ros::NodeHandle& pnh, ScanMatcherConfig& c) {
+  const ScanMatcherConfig& lo = ScanMatcherConfig::__getMin__();
+  const ScanMatcherConfig& hi = ScanMatcherConfig::__getMax__();
+  for (const auto& d : ScanMatcherConfig::__getParamDescriptions__()) {
+    boost::any value, min, max;
+    d->getValue(c, value);
+    d->getValue(lo, min);
+    d->getValue(hi, max);
+    dynamic_reconfigure::Config msg;
+    if (d->type == "double") {
+      const double v = readParam(pnh, d->name, boost::any_cast<double>(value),
+                                 boost::any_cast<double>(min), boost::any_cast<double>(max),
+                                 unitOf(d->description));
+      dynamic_reconfigure::ConfigTools::appendParameter(msg, d->name, v);
+    } else if (d->type == "int") {
+      const int v = readParam(pnh, d->name, boost::any_cast<int>(value),
+                              boost::any_cast<int>(min), boost::any_cast<int>(max),
+                              unitOf(d->description));
+      dynamic_reconfigure::ConfigTools::appendParameter(msg, d->name, v);
+    } else if (d->type == "bool") {
+      const bool v = getBool(pnh, d->name, boost::any_cast<bool>(value));
+      dynamic_reconfigure::ConfigTools::appendParameter(msg, d->name, v);
+    } else {
+      throw ParamError("parameter ~" + d->name + ": unsupported cfg type " + d->type);
+    }
+    d->fromMessage(msg, c);
+  }
 }
 
 }  // namespace
@@ -109,31 +152,9 @@ NodeParams loadParams(const ros::NodeHandle& pnh) {
   const double byte_megabytes = readParam(pnh, "byte_grid_megabytes", 4.0, 0.0, 256.0, "MB");
   p.matcher.registration.grid.max_byte_cubes = std::uint64_t(byte_megabytes * 1024.0 * 1024.0);
 
-  // Live parameters: ranges as in cfg/ScanMatcher.cfg.
+  // Live parameters: names, types and ranges from cfg/ScanMatcher.cfg, defaults from the code.
   ScanMatcherConfig c = toConfig(p);
-  c.cube_edge = readParam(pnh, "cube_edge", c.cube_edge, 0.05, 5.0, "m");
-  c.vertices = readParam(pnh, "vertices", c.vertices, 7, 1000);
-  c.iterations = readParam(pnh, "iterations", c.iterations, 1, 100000);
-  c.bounds_translation = readParam(pnh, "bounds_translation", c.bounds_translation, 0.01, 20.0, "m");
-  c.bounds_rotation = readParam(pnh, "bounds_rotation", c.bounds_rotation, 0.1, 90.0, "deg");
-  c.starts = readParam(pnh, "starts", c.starts, 1, 64);
-  c.threads = readParam(pnh, "threads", c.threads, 1, 64);
-  c.collapse_fraction = readParam(pnh, "collapse_fraction", c.collapse_fraction, 0.0, 1.0);
-  c.refine = getBool(pnh, "refine", c.refine);
-  c.refine_edge_fraction = readParam(pnh, "refine_edge_fraction", c.refine_edge_fraction, 0.05, 0.95);
-  c.refine_grids = readParam(pnh, "refine_grids", c.refine_grids, 1, 8);
-  c.refine_candidates = readParam(pnh, "refine_candidates", c.refine_candidates, 1, 64);
-  c.refine_coarse_weight =
-      readParam(pnh, "refine_coarse_weight", c.refine_coarse_weight, 0.0, 100.0);
-  c.seed = readParam(pnh, "seed", c.seed, 0, 2147483647);
-  c.min_overlap = readParam(pnh, "min_overlap", c.min_overlap, 0.0, 1.0);
-  c.min_j_gain = readParam(pnh, "min_j_gain", c.min_j_gain, 0, 1000000);
-  c.max_correction_translation =
-      readParam(pnh, "max_correction_translation", c.max_correction_translation, 0.01, 100.0, "m");
-  c.max_correction_rotation =
-      readParam(pnh, "max_correction_rotation", c.max_correction_rotation, 0.1, 180.0, "deg");
-  c.max_consecutive_rejections =
-      readParam(pnh, "max_consecutive_rejections", c.max_consecutive_rejections, 1, 1000000);
+  readLiveParams(pnh, c);
   applyConfig(c, p);
   return p;
 }

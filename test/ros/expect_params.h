@@ -1,6 +1,10 @@
-// Test helper: two dynamic_reconfigure configs hold the same live parameters.
+// Test helper: two dynamic_reconfigure configs hold the same live parameters (every parameter
+// of cfg/ScanMatcher.cfg, found through the generated descriptions).
 #pragma once
 
+#include <cmath>
+
+#include <boost/any.hpp>
 #include <gtest/gtest.h>
 
 #include "cube_scan_matcher/ScanMatcherConfig.h"
@@ -8,25 +12,21 @@
 namespace cube_scan_matcher {
 
 inline void expectSameLiveParams(const ScanMatcherConfig& a, const ScanMatcherConfig& b) {
-  EXPECT_DOUBLE_EQ(a.cube_edge, b.cube_edge);
-  EXPECT_EQ(a.vertices, b.vertices);
-  EXPECT_EQ(a.iterations, b.iterations);
-  EXPECT_NEAR(a.bounds_translation, b.bounds_translation, 1e-12);
-  EXPECT_NEAR(a.bounds_rotation, b.bounds_rotation, 1e-9);
-  EXPECT_EQ(a.starts, b.starts);
-  EXPECT_EQ(a.threads, b.threads);
-  EXPECT_DOUBLE_EQ(a.collapse_fraction, b.collapse_fraction);
-  EXPECT_EQ(a.refine, b.refine);
-  EXPECT_DOUBLE_EQ(a.refine_edge_fraction, b.refine_edge_fraction);
-  EXPECT_EQ(a.refine_grids, b.refine_grids);
-  EXPECT_EQ(a.refine_candidates, b.refine_candidates);
-  EXPECT_DOUBLE_EQ(a.refine_coarse_weight, b.refine_coarse_weight);
-  EXPECT_EQ(a.seed, b.seed);
-  EXPECT_DOUBLE_EQ(a.min_overlap, b.min_overlap);
-  EXPECT_EQ(a.min_j_gain, b.min_j_gain);
-  EXPECT_NEAR(a.max_correction_translation, b.max_correction_translation, 1e-12);
-  EXPECT_NEAR(a.max_correction_rotation, b.max_correction_rotation, 1e-9);
-  EXPECT_EQ(a.max_consecutive_rejections, b.max_consecutive_rejections);
+  for (const auto& d : ScanMatcherConfig::__getParamDescriptions__()) {
+    boost::any va, vb;
+    d->getValue(a, va);
+    d->getValue(b, vb);
+    if (d->type == "double") {
+      const double x = boost::any_cast<double>(va), y = boost::any_cast<double>(vb);
+      EXPECT_NEAR(x, y, 1e-9 * std::max(1.0, std::abs(x))) << d->name;
+    } else if (d->type == "int") {
+      EXPECT_EQ(boost::any_cast<int>(va), boost::any_cast<int>(vb)) << d->name;
+    } else if (d->type == "bool") {
+      EXPECT_EQ(boost::any_cast<bool>(va), boost::any_cast<bool>(vb)) << d->name;
+    } else {
+      ADD_FAILURE() << d->name << ": unexpected cfg type " << d->type;
+    }
+  }
 }
 
 }  // namespace cube_scan_matcher
