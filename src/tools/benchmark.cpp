@@ -15,14 +15,16 @@
 #include <string>
 #include <vector>
 
-#include "cloud_io.h"
 #include "cube_scan_matcher/core/filters.h"
+#include "cube_scan_matcher/core/metrics.h"
 #include "cube_scan_matcher/core/registration.h"
-#include "dataset.h"
+#include "cube_scan_matcher/io/cloud_io.h"
+#include "cube_scan_matcher/io/dataset.h"
 #include "peer_methods.h"
 #include "settings_cli.h"
 
 using namespace cube_scan_matcher;
+using namespace cube_scan_matcher::io;
 using namespace cube_scan_matcher::tools;
 
 namespace {

@@ -7,7 +7,7 @@
 #include <pcl/registration/icp.h>
 #include <pcl/registration/ndt.h>
 
-namespace cube_scan_matcher::tools {
+namespace cube_scan_matcher::io {
 
 namespace {
 using Clock = std::chrono::steady_clock;
@@ -85,4 +85,4 @@ Cloud::Ptr voxelCopy(const Cloud::ConstPtr& cloud, float leaf) {
   return out;
 }
 
-}  // namespace cube_scan_matcher::tools
+}  // namespace cube_scan_matcher::io

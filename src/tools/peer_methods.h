@@ -8,7 +8,7 @@
 #include <pcl/point_cloud.h>
 #include <pcl/point_types.h>
 
-namespace cube_scan_matcher::tools {
+namespace cube_scan_matcher::io {
 
 using Cloud = pcl::PointCloud<pcl::PointXYZ>;
 
@@ -31,4 +31,4 @@ PeerResult runGicp(const Cloud::ConstPtr& source, const Cloud::ConstPtr& target,
 /// 0.2 m voxel-grid copy (centroids), as in the benchmark's "voxel" variants.
 Cloud::Ptr voxelCopy(const Cloud::ConstPtr& cloud, float leaf);
 
-}  // namespace cube_scan_matcher::tools
+}  // namespace cube_scan_matcher::io

@@ -5,9 +5,9 @@
 #include <string>
 #include <vector>
 
-#include "cloud_io.h"
 #include "cube_scan_matcher/core/filters.h"
 #include "cube_scan_matcher/core/registration.h"
+#include "cube_scan_matcher/io/cloud_io.h"
 #include "settings_cli.h"
 
 using namespace cube_scan_matcher;
@@ -39,7 +39,7 @@ int main(int argc, char** argv) {
       if (args[i] == "--guess") {
         if (i + 6 >= args.size()) throw std::invalid_argument("--guess needs 6 numbers");
         for (int k = 0; k < 6; ++k) {
-          const double v = tools::parseNumber("--guess", args[i + 1 + k]);
+          const double v = io::parseNumber("--guess", args[i + 1 + k]);
           guess[k] = k < 3 ? v : deg2rad(v);
         }
         i += 7;
@@ -58,9 +58,9 @@ int main(int argc, char** argv) {
     CubeRegistration reg(settings);
     FilterStats ref_stats, scan_stats;
     const PointArray ref =
-        filterPoints(tools::toPointArray(*tools::loadCloud(files[0])), filter, &ref_stats);
+        filterPoints(io::toPointArray(*io::loadCloud(files[0])), filter, &ref_stats);
     const PointArray scan =
-        filterPoints(tools::toPointArray(*tools::loadCloud(files[1])), filter, &scan_stats);
+        filterPoints(io::toPointArray(*io::loadCloud(files[1])), filter, &scan_stats);
     if (ref.empty()) throw std::runtime_error(files[0] + ": no valid point after filtering");
     if (scan.empty()) throw std::runtime_error(files[1] + ": no valid point after filtering");
     reg.setReference(ref);

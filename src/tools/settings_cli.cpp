@@ -53,15 +53,6 @@ std::string algorithmOptionsHelp() {
          "                        restarts around the initial estimate (resets the options before it)\n";
 }
 
-double parseNumber(const std::string& option, const std::string& value) {
-  char* end = nullptr;
-  const double v = std::strtod(value.c_str(), &end);
-  if (value.empty() || *end != '\0') {
-    throw std::invalid_argument(option + ": '" + value + "' is not a number");
-  }
-  return v;
-}
-
 bool parseAlgorithmOption(const std::vector<std::string>& args, std::size_t& i,
                           RegistrationSettings& s, RangeFilterSettings& f) {
   const std::string& a = args[i];
@@ -69,7 +60,7 @@ bool parseAlgorithmOption(const std::vector<std::string>& args, std::size_t& i,
     if (i + k >= args.size()) throw std::invalid_argument(a + ": missing value");
     return args[i + k];
   };
-  auto value = [&](int k) { return parseNumber(a, word(k)); };
+  auto value = [&](int k) { return io::parseNumber(a, word(k)); };
   std::size_t used = 1;
   if (a == "--edge") {
     s.grid.cube_edge = value(1), used = 2;

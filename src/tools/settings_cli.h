@@ -6,6 +6,7 @@
 
 #include "cube_scan_matcher/core/filters.h"
 #include "cube_scan_matcher/core/registration.h"
+#include "cube_scan_matcher/io/dataset.h"
 
 namespace cube_scan_matcher::tools {
 
@@ -16,8 +17,5 @@ std::string algorithmOptionsHelp();
 /// `filter`, advances i past it and returns true. Throws std::invalid_argument on a bad value.
 bool parseAlgorithmOption(const std::vector<std::string>& args, std::size_t& i,
                           RegistrationSettings& settings, RangeFilterSettings& filter);
-
-/// Reads a number or throws std::invalid_argument naming the option.
-double parseNumber(const std::string& option, const std::string& value);
 
 }  // namespace cube_scan_matcher::tools

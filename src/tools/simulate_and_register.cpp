@@ -9,10 +9,10 @@
 #include <string>
 #include <vector>
 
+#include "cube_scan_matcher/core/metrics.h"
 #include "cube_scan_matcher/core/registration.h"
 #include "cube_scan_matcher/sim/motion.h"
 #include "cube_scan_matcher/sim/tilting_scanner.h"
-#include "dataset.h"
 #include "settings_cli.h"
 
 using namespace cube_scan_matcher;
@@ -43,8 +43,8 @@ int main(int argc, char** argv) {
       if (i + 1 >= args.size()) throw std::invalid_argument(a + ": missing value or unknown option");
       const std::string v = args[i + 1];
       if (a == "--scene") scene_name = v;
-      else if (a == "--sweeps") sweeps = int(tools::parseNumber(a, v));
-      else if (a == "--scene-seed") seed = std::uint64_t(tools::parseNumber(a, v));
+      else if (a == "--sweeps") sweeps = int(io::parseNumber(a, v));
+      else if (a == "--scene-seed") seed = std::uint64_t(io::parseNumber(a, v));
       else if (a == "--odometry-error") odometry_error = v;
       else throw std::invalid_argument("unknown option or value: " + a + " " + v);
       i += 2;
@@ -77,8 +77,8 @@ int main(int argc, char** argv) {
       const Eigen::Isometry3d truth = prev_sensor.inverse() * sensor;
       const Pose6 guess = isometryToPose(prev_odom.inverse() * odom);
       const RegistrationResult r = reg.align(pts, guess);
-      const tools::PoseError e = tools::poseError(r.transform, truth);
-      const tools::PoseError eg = tools::poseError(poseToIsometry(guess), truth);
+      const PoseError e = poseError(r.transform, truth);
+      const PoseError eg = poseError(poseToIsometry(guess), truth);
       es.push_back(e.es_m);
       ea.push_back(e.ea_deg);
       ok += e.es_m < 0.10 && e.ea_deg < 1.0;

@@ -8,7 +8,7 @@
 
 #include <ros/ros.h>
 
-#include "cube_scan_matcher/ros/sweep_evaluator.h"
+#include "cube_scan_matcher/ros_tools/sweep_evaluator.h"
 
 using cube_scan_matcher::SweepEvaluator;
 

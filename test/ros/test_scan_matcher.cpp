@@ -23,10 +23,10 @@
 #include "cube_scan_matcher/Status.h"
 #include "cube_scan_matcher/core/pose.h"
 #include "cube_scan_matcher/ros/cloud_conversion.h"
-#include "cube_scan_matcher/ros/transforms.h"
-#include "expect_params.h"
 #include "cube_scan_matcher/ros/params.h"
+#include "cube_scan_matcher/ros/transforms.h"
 #include "cube_scan_matcher/sim/tilting_scanner.h"
+#include "expect_params.h"
 
 using namespace cube_scan_matcher;
 

@@ -1,4 +1,4 @@
-#include "cloud_io.h"
+#include "cube_scan_matcher/io/cloud_io.h"
 
 #include <sys/stat.h>
 
@@ -11,7 +11,7 @@
 #include <pcl/io/pcd_io.h>
 #include <pcl/io/ply_io.h>
 
-namespace cube_scan_matcher::tools {
+namespace cube_scan_matcher::io {
 
 pcl::PointCloud<pcl::PointXYZ>::Ptr loadCloud(const std::string& path) {
   struct stat st;
@@ -48,4 +48,4 @@ PointArray toPointArray(const pcl::PointCloud<pcl::PointXYZ>& cloud) {
   return out;
 }
 
-}  // namespace cube_scan_matcher::tools
+}  // namespace cube_scan_matcher::io

@@ -1,12 +1,12 @@
-#include "cube_scan_matcher/ros/sweep_evaluator.h"
+#include "cube_scan_matcher/ros_tools/sweep_evaluator.h"
 
 #include <algorithm>
 #include <cstdio>
 
 #include <tf2_eigen/tf2_eigen.h>
 
+#include "cube_scan_matcher/core/metrics.h"
 #include "cube_scan_matcher/core/pose.h"
-#include "dataset.h"
 
 namespace cube_scan_matcher {
 
@@ -58,9 +58,9 @@ void SweepEvaluator::update() {
       const Eigen::Isometry3d true_inc = p.truth.inverse() * s.truth;
       Pose6 g;
       for (int k = 0; k < 6; ++k) g[k] = s.status.guess[std::size_t(k)];
-      const tools::PoseError eg = tools::poseError(poseToIsometry(g), true_inc);
-      const tools::PoseError ei = tools::poseError(p.pose.inverse() * s.pose, true_inc);
-      const tools::PoseError ea = tools::poseError(s.pose, s.truth);
+      const PoseError eg = poseError(poseToIsometry(g), true_inc);
+      const PoseError ei = poseError(p.pose.inverse() * s.pose, true_inc);
+      const PoseError ea = poseError(s.pose, s.truth);
       row.guess_es = eg.es_m, row.guess_ea = eg.ea_deg;
       row.inc_es = ei.es_m, row.inc_ea = ei.ea_deg;
       row.acc_es = ea.es_m, row.acc_ea = ea.ea_deg;

@@ -1,13 +1,21 @@
-#include "dataset.h"
+#include "cube_scan_matcher/io/dataset.h"
 
 #include <cmath>
+#include <cstdlib>
 #include <fstream>
 #include <sstream>
 #include <stdexcept>
 
-#include "cube_scan_matcher/core/pose.h"
+namespace cube_scan_matcher::io {
 
-namespace cube_scan_matcher::tools {
+double parseNumber(const std::string& what, const std::string& text) {
+  char* end = nullptr;
+  const double v = std::strtod(text.c_str(), &end);
+  if (text.empty() || *end != '\0') {
+    throw std::invalid_argument(what + ": '" + text + "' is not a number");
+  }
+  return v;
+}
 
 bool readPose(std::istream& in, Eigen::Isometry3d& T, double* quaternion_norm) {
   double t[3], q[4];
@@ -47,15 +55,4 @@ std::vector<PairEntry> readPairs(const std::string& dir) {
   return pairs;
 }
 
-PoseError poseError(const Eigen::Isometry3d& estimate, const Eigen::Isometry3d& reference) {
-  const Pose6 a = isometryToPose(estimate);
-  const Pose6 b = isometryToPose(reference);
-  double sum = 0.0;
-  for (int k = 3; k < 6; ++k) {
-    const double d = wrapAngle(a[k] - b[k]);
-    sum += d * d;
-  }
-  return {(a.head<3>() - b.head<3>()).norm(), rad2deg(std::sqrt(sum))};
-}
-
-}  // namespace cube_scan_matcher::tools
+}  // namespace cube_scan_matcher::io

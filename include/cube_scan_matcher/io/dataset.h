@@ -8,7 +8,7 @@
 
 #include <Eigen/Geometry>
 
-namespace cube_scan_matcher::tools {
+namespace cube_scan_matcher::io {
 
 struct PairEntry {
   std::string source;  ///< newer scan (path joined with the folder)
@@ -22,14 +22,10 @@ struct PairEntry {
 /// receives the norm before normalising.
 bool readPose(std::istream& in, Eigen::Isometry3d& T, double* quaternion_norm = nullptr);
 
+/// Reads a number or throws std::invalid_argument naming `what` (an option or a field).
+double parseNumber(const std::string& what, const std::string& text);
+
 /// Reads DIR/pairs.txt. Throws std::runtime_error naming the file and line on bad input.
 std::vector<PairEntry> readPairs(const std::string& dir);
 
-/// Errors of eqs. (7)-(8): Es [m] and Ea [deg] between an estimate and a reference.
-struct PoseError {
-  double es_m;
-  double ea_deg;
-};
-PoseError poseError(const Eigen::Isometry3d& estimate, const Eigen::Isometry3d& reference);
-
-}  // namespace cube_scan_matcher::tools
+}  // namespace cube_scan_matcher::io

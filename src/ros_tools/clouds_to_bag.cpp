@@ -11,12 +11,11 @@
 #include <rosbag/bag.h>
 #include <tf2_msgs/TFMessage.h>
 
-#include "cloud_io.h"
+#include "cube_scan_matcher/io/cloud_io.h"
+#include "cube_scan_matcher/io/dataset.h"
 #include "cube_scan_matcher/ros/cloud_conversion.h"
 #include "cube_scan_matcher/ros/transforms.h"
 #include "cube_scan_matcher/sim/motion.h"
-#include "dataset.h"
-#include "settings_cli.h"
 
 using namespace cube_scan_matcher;
 
@@ -60,15 +59,15 @@ int main(int argc, char** argv) {
       };
       if (a == "--dataset") dataset = value();
       else if (a == "--poses") poses_file = value();
-      else if (a == "--rate") rate = tools::parseNumber(a, value());
-      else if (a == "--start") start = tools::parseNumber(a, value());
+      else if (a == "--rate") rate = io::parseNumber(a, value());
+      else if (a == "--start") start = io::parseNumber(a, value());
       else if (a == "--topic") topic = value();
       else if (a == "--frame") frame = value();
       else if (a == "--odom-frame") odom_frame = value();
-      else if (a == "--seed") seed = std::uint64_t(tools::parseNumber(a, value()));
+      else if (a == "--seed") seed = std::uint64_t(io::parseNumber(a, value()));
       else if (a == "--odometry-error") {
-        err_t = tools::parseNumber(a, value());
-        err_a = tools::parseNumber(a, value());
+        err_t = io::parseNumber(a, value());
+        err_a = io::parseNumber(a, value());
       } else if (a.rfind("--", 0) == 0) throw std::invalid_argument("unknown option " + a);
       else clouds.push_back(a);
     }
@@ -79,7 +78,7 @@ int main(int argc, char** argv) {
         throw std::invalid_argument("--dataset replaces CLOUD... and --poses");
       // Chain the pairs: the first pair's target is the origin; a source's pose is its
       // target's pose times T_target_source.
-      const auto pairs = tools::readPairs(dataset);
+      const auto pairs = io::readPairs(dataset);
       std::map<std::string, Eigen::Isometry3d> pose_of;
       clouds.push_back(pairs.front().target);
       pose_of[pairs.front().target] = Eigen::Isometry3d::Identity();
@@ -102,7 +101,7 @@ int main(int argc, char** argv) {
         if (line.empty() || line[0] == '#') continue;
         std::istringstream ls(line);
         Eigen::Isometry3d T;
-        if (!tools::readPose(ls, T)) {
+        if (!io::readPose(ls, T)) {
           throw std::runtime_error(poses_file + ":" + std::to_string(n) +
                                    ": expected tx ty tz qx qy qz qw");
         }
@@ -129,7 +128,7 @@ int main(int argc, char** argv) {
     rosbag::Bag bag(output, rosbag::bagmode::Write);
     for (std::size_t k = 0; k < clouds.size(); ++k) {
       const ros::Time stamp(start + double(k) / rate);
-      const PointArray pts = tools::toPointArray(*tools::loadCloud(clouds[k]));
+      const PointArray pts = io::toPointArray(*io::loadCloud(clouds[k]));
       std_msgs::Header header;
       header.stamp = stamp;
       header.frame_id = frame;

@@ -4,7 +4,7 @@
 
 #include <ros/ros.h>
 
-#include "cube_scan_matcher/ros/sweep_evaluator.h"
+#include "cube_scan_matcher/ros_tools/sweep_evaluator.h"
 
 int main(int argc, char** argv) {
   ros::init(argc, argv, "sim_evaluator");
