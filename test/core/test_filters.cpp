@@ -1,10 +1,10 @@
+// Range and finiteness filters: what is dropped, and settings refused by name.
 #include <gtest/gtest.h>
 
 #include <cmath>
 #include <limits>
 
 #include "cube_scan_matcher/core/filters.h"
-#include "cube_scan_matcher/core/voxel_collapse.h"
 
 using namespace cube_scan_matcher;
 
@@ -51,15 +51,4 @@ TEST(Filters, InvalidSettingsAreRefusedByName) {
   } catch (const std::invalid_argument& e) {
     EXPECT_NE(std::string(e.what()).find("max_range"), std::string::npos);
   }
-}
-
-TEST(VoxelCollapse, KeepsOnePointPerVoxel) {
-  PointArray in;
-  for (int i = 0; i < 10; ++i) in.push_back(0.01f * i, 0.01f, 0.01f);  // one 0.25 m voxel
-  in.push_back(1.1f, 0.1f, 0.1f);
-  in.push_back(-0.1f, 0.1f, 0.1f);  // negative side is another voxel
-  const PointArray out = collapseToVoxels(in, 0.25);
-  EXPECT_EQ(out.size(), 3u);
-  EXPECT_FLOAT_EQ(out.x[0], 0.f);  // the first point of a voxel is kept
-  EXPECT_THROW(collapseToVoxels(in, 0.0), std::invalid_argument);
 }

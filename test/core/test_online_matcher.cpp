@@ -1,10 +1,8 @@
-// OnlineMatcher (the nodelet's core), the acceptance gate and compass search, without ROS.
+// OnlineMatcher (the nodelet's core) without ROS: chaining, resets, rejections.
 #include <gtest/gtest.h>
 
 #include <random>
 
-#include "cube_scan_matcher/core/acceptance_gate.h"
-#include "cube_scan_matcher/core/compass_search.h"
 #include "cube_scan_matcher/core/online_matcher.h"
 #include "cube_scan_matcher/sim/motion.h"
 #include "cube_scan_matcher/sim/tilting_scanner.h"
@@ -30,55 +28,6 @@ double translationError(const Eigen::Isometry3d& a, const Eigen::Isometry3d& b) 
 }
 
 }  // namespace
-
-TEST(CompassSearch, ClimbsASmoothPeakToTheStepResolution) {
-  Vector6d peak;
-  peak << 0.3, -0.2, 0.1, 0.02, -0.01, 0.03;
-  auto f = [&](const Vector6d& x) { return -(x - peak).squaredNorm(); };
-  CompassSettings s;
-  s.levels = 10;
-  const CompassResult r = compassMaximize(f, Vector6d::Zero(), s);
-  EXPECT_LT((r.best - peak).norm(), 1e-3);
-  EXPECT_GT(r.moves, 0);
-  EXPECT_GE(r.best_value, r.initial_value);
-}
-
-TEST(CompassSearch, RespectsTheEvaluationBudgetAndValidates) {
-  int calls = 0;
-  CompassSettings s;
-  s.max_evaluations = 17;
-  compassMaximize([&](const Vector6d& x) { ++calls; return x.sum(); }, Vector6d::Zero(), s);
-  EXPECT_EQ(calls, 17);
-  s.levels = 0;
-  EXPECT_THROW(compassMaximize([](const Vector6d&) { return 0.0; }, Vector6d::Zero(), s),
-               std::invalid_argument);
-}
-
-TEST(AcceptanceGate, RejectsLowOverlapNoGainAndLargeCorrections) {
-  RegistrationResult r;
-  r.status = RegistrationStatus::Ok;
-  r.reference_cubes = 1000;
-  r.J = 500;
-  r.J_guess = 400;
-  r.pose << 0.2, 0, 0, 0, 0, 0;
-  r.transform = poseToIsometry(r.pose);
-  const Pose6 guess = Pose6::Zero();
-  GateSettings g;
-  EXPECT_EQ(gate(r, guess, g), GateReason::Accepted);
-  g.min_overlap = 0.6;
-  EXPECT_EQ(gate(r, guess, g), GateReason::LowOverlap);
-  g = GateSettings{};
-  g.min_j_gain = 200;
-  EXPECT_EQ(gate(r, guess, g), GateReason::NoGain);
-  g = GateSettings{};
-  g.max_correction_m = 0.1;
-  EXPECT_EQ(gate(r, guess, g), GateReason::CorrectionTooLarge);
-  r.status = RegistrationStatus::NoOverlap;
-  EXPECT_EQ(gate(r, guess, GateSettings{}), GateReason::RegistrationFailed);
-  g = GateSettings{};
-  g.min_overlap = 1.5;
-  EXPECT_THROW(validate(g), std::invalid_argument);
-}
 
 TEST(OnlineMatcher, ChainsIncrementsFromBigOdometryErrors) {
   const sim::Scene scene = sim::Scene::generate(sim::SceneType::Urban, 4);
@@ -150,21 +99,4 @@ TEST(OnlineMatcher, ConsecutiveRejectionsRaiseTheAlarmAndPropagateOdometry) {
   EXPECT_EQ(s.reason, GateReason::CorrectionTooLarge) << s.message;
   EXPECT_TRUE(s.rejection_alarm);
   EXPECT_EQ(s.consecutive_rejections, 2);
-}
-
-TEST(SimMotion, StaysInTheSceneAndMovesLikeThePapersPairs) {
-  const sim::Scene scene = sim::Scene::generate(sim::SceneType::Urban, 1);
-  sim::RobotMotion robot(scene, sim::MotionSettings{}, 2);
-  Eigen::Isometry3d prev = robot.pose();
-  for (int k = 0; k < 200; ++k) {
-    robot.advance();
-    const Eigen::Isometry3d inc = prev.inverse() * robot.pose();
-    EXPECT_LE(inc.translation().head<2>().norm(), 5.0 + 1e-6);
-    EXPECT_LE(rad2deg(std::abs(isometryToPose(inc)[5])), 45.0 + 2.0);
-    EXPECT_LT(std::abs(robot.pose().translation().y()), 8.0);
-    EXPECT_GT(robot.pose().translation().x(), -20.0);
-    EXPECT_LT(robot.pose().translation().x(), 140.0);
-    prev = robot.pose();
-  }
-  EXPECT_THROW(sim::odometryErrorFromString("huge"), std::invalid_argument);
 }

@@ -6,6 +6,8 @@
 #include <cstdio>
 #include <algorithm>
 #include <random>
+#include <string>
+#include <tuple>
 #include <thread>
 #include <vector>
 
@@ -46,30 +48,64 @@ Scans makeScans(sim::SceneType type, std::uint64_t seed) {
   return s;
 }
 
-struct Case {
-  sim::SceneType scene;
-  bool reverse;  // register first -> second instead of second -> first
+enum class Mode { Default, Paper, BitCopies };
+
+std::string toString(Mode m) {
+  switch (m) {
+    case Mode::Default: return "default";
+    case Mode::Paper: return "paper";
+    case Mode::BitCopies: return "bitcopies";
+  }
+  return "unknown";
+}
+
+/// The shipped settings, the paper's fixed mode, and the shipped settings counting on bit
+/// copies of V (as grids above max_byte_cubes do).
+RegistrationSettings settingsFor(Mode m) {
+  RegistrationSettings s = m == Mode::Paper ? RegistrationSettings::paper() : RegistrationSettings{};
+  if (m == Mode::BitCopies) s.grid.max_byte_cubes = 0;
+  return s;
+}
+
+/// Bounds [m, deg]: at least `min_successes` of the 6 trials within trial_m / trial_deg, and
+/// the (upper) median within median_m / median_deg. The package's modes must get every trial
+/// within 5 cm. The paper's mode (one GNMM of 500 iterations on E = 0.5 m cubes, no refine)
+/// lands in a wrong local maximum in a part of the trials from these big errors (measured,
+/// session 4: 2-6 of 6 per case within 0.25 m, 32/48 in all; on the real corridor pairs 16/25
+/// and 0/25, BENCHMARK.md): for it the test guards that it still converges in some trials and
+/// in the median improves on the start (about 1 m off).
+struct Tolerance {
+  int min_successes;
+  double trial_m, trial_deg, median_m, median_deg;
 };
+Tolerance toleranceFor(Mode m) {
+  return m == Mode::Paper ? Tolerance{1, 0.25, 2.0, 0.9, 8.0} : Tolerance{6, 0.05, 0.5, 0.03, 0.30};
+}
+
+using Case = std::tuple<Mode, sim::SceneType, bool>;  // bool: register first -> second
 
 class SyntheticRegistration : public ::testing::TestWithParam<Case> {};
 
 // From the paper's *big* initial errors (+-1 m, +-8 deg per parameter), both directions, all
-// four scenes: median error < 3 cm / 0.3 deg per scene, no trial beyond 5 cm / 0.5 deg, and J
-// never below J at the guess. (Measured, session 3: medians 1.1-1.7 cm, worst trial 3.6 cm.)
+// four scenes, in each mode: the trials and the median within the mode's tolerance, and J
+// never below J at the guess. (Measured, session 4, default mode: medians 1.1-1.7 cm, worst
+// trial 3.6 cm; bit copies give the default's results exactly.)
 TEST_P(SyntheticRegistration, RecoversKnownTransformFromBigInitialErrors) {
-  const Case c = GetParam();
-  const Scans s = makeScans(c.scene, 11);
-  const PointArray& ref = c.reverse ? s.second : s.first;
-  const PointArray& scan = c.reverse ? s.first : s.second;
-  const Eigen::Isometry3d truth = c.reverse ? s.T_first_second.inverse() : s.T_first_second;
+  const auto [mode, scene, reverse] = GetParam();
+  const Scans s = makeScans(scene, 11);
+  const PointArray& ref = reverse ? s.second : s.first;
+  const PointArray& scan = reverse ? s.first : s.second;
+  const Eigen::Isometry3d truth = reverse ? s.T_first_second.inverse() : s.T_first_second;
   ASSERT_GT(scan.size(), 20000u);
+  const Tolerance tol = toleranceFor(mode);
 
-  CubeRegistration reg(RegistrationSettings{});
+  CubeRegistration reg(settingsFor(mode));
   reg.setReference(ref);
   std::mt19937_64 rng(5);
   std::uniform_real_distribution<double> u(-1.0, 1.0);
   const Pose6 truth_pose = isometryToPose(truth);
   std::vector<double> dts, das;
+  int successes = 0;
   for (int trial = 0; trial < 6; ++trial) {
     Pose6 guess = truth_pose;
     for (int k = 0; k < 3; ++k) guess[k] += 1.0 * u(rng);
@@ -79,32 +115,33 @@ TEST_P(SyntheticRegistration, RecoversKnownTransformFromBigInitialErrors) {
     const Eigen::Isometry3d err = truth.inverse() * r.transform;
     const double dt = (r.transform.translation() - truth.translation()).norm();
     const double da = rad2deg(Eigen::AngleAxisd(err.linear()).angle());
-    std::printf("[ trial    ] %s %d: %.3f m %.3f deg, %s\n", sim::toString(c.scene).c_str(), trial,
-                dt, da, r.message.c_str());
-    EXPECT_LT(dt, 0.05);
-    EXPECT_LT(da, 0.5);
+    std::printf("[ trial    ] %s %s %d: %.3f m %.3f deg, %s\n", toString(mode).c_str(),
+                sim::toString(scene).c_str(), trial, dt, da, r.message.c_str());
+    successes += dt < tol.trial_m && da < tol.trial_deg;
     EXPECT_GE(r.J, r.J_guess);
     dts.push_back(dt);
     das.push_back(da);
   }
+  EXPECT_GE(successes, tol.min_successes)
+      << "trials within " << tol.trial_m << " m and " << tol.trial_deg << " deg";
   std::nth_element(dts.begin(), dts.begin() + 3, dts.end());
   std::nth_element(das.begin(), das.begin() + 3, das.end());
-  EXPECT_LT(dts[3], 0.03);
-  EXPECT_LT(das[3], 0.30);
+  EXPECT_LT(dts[3], tol.median_m);
+  EXPECT_LT(das[3], tol.median_deg);
 }
 
 INSTANTIATE_TEST_SUITE_P(
-    Scenes, SyntheticRegistration,
-    ::testing::Values(Case{sim::SceneType::Hall, false}, Case{sim::SceneType::Hall, true},
-                      Case{sim::SceneType::Urban, false}, Case{sim::SceneType::Urban, true},
-                      Case{sim::SceneType::Park, false}, Case{sim::SceneType::Park, true},
-                      Case{sim::SceneType::Natural, false},
-                      Case{sim::SceneType::Natural, true}),
+    ModesAndScenes, SyntheticRegistration,
+    ::testing::Combine(::testing::Values(Mode::Default, Mode::Paper, Mode::BitCopies),
+                       ::testing::Values(sim::SceneType::Hall, sim::SceneType::Urban,
+                                         sim::SceneType::Park, sim::SceneType::Natural),
+                       ::testing::Bool()),
     [](const ::testing::TestParamInfo<Case>& i) {
-      return sim::toString(i.param.scene) + (i.param.reverse ? "_reverse" : "_forward");
+      return toString(std::get<0>(i.param)) + "_" + sim::toString(std::get<1>(i.param)) +
+             (std::get<2>(i.param) ? "_reverse" : "_forward");
     });
 
-TEST(Registration, PaperModeAlsoConverges) {
+TEST(Registration, PaperModeRunsOneGnmmOfFiveHundredIterationsOnAllPoints) {
   const Scans s = makeScans(sim::SceneType::Urban, 3);
   CubeRegistration reg(RegistrationSettings::paper(0.5));
   reg.setReference(s.first);

@@ -1,9 +1,11 @@
-// The simulated scanner against the paper's numbers (section 3.1).
+// The simulator: the tilting scanner against the paper's numbers (section 3.1), the scenes,
+// the robot motion.
 #include <gtest/gtest.h>
 
 #include <cmath>
 
 #include "cube_scan_matcher/core/pose.h"
+#include "cube_scan_matcher/sim/motion.h"
 #include "cube_scan_matcher/sim/tilting_scanner.h"
 
 using namespace cube_scan_matcher;
@@ -69,4 +71,21 @@ TEST(Scene, SameSeedSameWorld) {
     EXPECT_EQ(a.raycast(o, d, 81), b.raycast(o, d, 81)) << name;
   }
   EXPECT_THROW(sim::sceneTypeFromString("moon"), std::invalid_argument);
+}
+
+TEST(SimMotion, StaysInTheSceneAndMovesLikeThePapersPairs) {
+  const sim::Scene scene = sim::Scene::generate(sim::SceneType::Urban, 1);
+  sim::RobotMotion robot(scene, sim::MotionSettings{}, 2);
+  Eigen::Isometry3d prev = robot.pose();
+  for (int k = 0; k < 200; ++k) {
+    robot.advance();
+    const Eigen::Isometry3d inc = prev.inverse() * robot.pose();
+    EXPECT_LE(inc.translation().head<2>().norm(), 5.0 + 1e-6);
+    EXPECT_LE(rad2deg(std::abs(isometryToPose(inc)[5])), 45.0 + 2.0);
+    EXPECT_LT(std::abs(robot.pose().translation().y()), 8.0);
+    EXPECT_GT(robot.pose().translation().x(), -20.0);
+    EXPECT_LT(robot.pose().translation().x(), 140.0);
+    prev = robot.pose();
+  }
+  EXPECT_THROW(sim::odometryErrorFromString("huge"), std::invalid_argument);
 }

@@ -1,0 +1,33 @@
+// The acceptance gate: low overlap, no gain and large corrections are rejected with reasons.
+#include <gtest/gtest.h>
+
+#include "cube_scan_matcher/core/acceptance_gate.h"
+#include "cube_scan_matcher/core/pose.h"
+
+using namespace cube_scan_matcher;
+
+TEST(AcceptanceGate, RejectsLowOverlapNoGainAndLargeCorrections) {
+  RegistrationResult r;
+  r.status = RegistrationStatus::Ok;
+  r.reference_cubes = 1000;
+  r.J = 500;
+  r.J_guess = 400;
+  r.pose << 0.2, 0, 0, 0, 0, 0;
+  r.transform = poseToIsometry(r.pose);
+  const Pose6 guess = Pose6::Zero();
+  GateSettings g;
+  EXPECT_EQ(gate(r, guess, g), GateReason::Accepted);
+  g.min_overlap = 0.6;
+  EXPECT_EQ(gate(r, guess, g), GateReason::LowOverlap);
+  g = GateSettings{};
+  g.min_j_gain = 200;
+  EXPECT_EQ(gate(r, guess, g), GateReason::NoGain);
+  g = GateSettings{};
+  g.max_correction_m = 0.1;
+  EXPECT_EQ(gate(r, guess, g), GateReason::CorrectionTooLarge);
+  r.status = RegistrationStatus::NoOverlap;
+  EXPECT_EQ(gate(r, guess, GateSettings{}), GateReason::RegistrationFailed);
+  g = GateSettings{};
+  g.min_overlap = 1.5;
+  EXPECT_THROW(validate(g), std::invalid_argument);
+}
