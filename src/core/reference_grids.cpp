@@ -7,16 +7,14 @@
 namespace cube_scan_matcher {
 
 ReferenceGrids buildReferenceGrids(const PointArray& reference, const CubeGridSettings& grid,
-                                   const RefineSettings& refine, int threads) {
+                                   int fine_grids, double fine_edge_fraction, int threads) {
   // specs[0] is the E grid, the rest are the fine grids.
   std::vector<CubeGridSettings> specs{grid};
-  if (refine.enabled) {
-    CubeGridSettings gs = grid;
-    gs.cube_edge *= refine.edge_fraction;
-    for (int k = 0; k < refine.grids; ++k) {
-      gs.origin_shift = double(k) / refine.grids;
-      specs.push_back(gs);
-    }
+  CubeGridSettings gs = grid;
+  gs.cube_edge *= fine_edge_fraction;
+  for (int k = 0; k < fine_grids; ++k) {
+    gs.origin_shift = double(k) / fine_grids;
+    specs.push_back(gs);
   }
   std::vector<CubeGrid> grids(specs.size());
   std::vector<std::exception_ptr> errors(specs.size());

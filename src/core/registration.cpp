@@ -78,8 +78,10 @@ const CubeGrid& CubeRegistration::grid() const {
 
 void CubeRegistration::setReference(const PointArray& reference) {
   // All grids are built before any is replaced, so an error keeps the previous reference.
-  auto next = std::make_unique<ReferenceGrids>(buildReferenceGrids(
-      reference, settings_.grid, settings_.refine, settings_.search.threads));
+  const RefineSettings& rs = settings_.refine;
+  auto next = std::make_unique<ReferenceGrids>(
+      buildReferenceGrids(reference, settings_.grid, rs.enabled ? rs.grids : 0,
+                          rs.edge_fraction, settings_.search.threads));
   std::lock_guard<std::mutex> lock(*mutex_);
   // The working copies move to the new grids while the old ones are still alive.
   for (auto& w : workspaces_) w->retarget(*next);

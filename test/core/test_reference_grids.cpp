@@ -9,10 +9,7 @@ using namespace cube_scan_matcher::test;
 
 TEST(ReferenceGrids, TheEGridAndTheShiftedFineGrids) {
   const PointArray ref = cornerScene(3000, 5);
-  RefineSettings refine;
-  refine.grids = 3;
-  refine.edge_fraction = 0.5;
-  const ReferenceGrids g = buildReferenceGrids(ref, edge(0.5), refine, 2);
+  const ReferenceGrids g = buildReferenceGrids(ref, edge(0.5), 3, 0.5, 2);
   EXPECT_DOUBLE_EQ(g.coarse.edge(), 0.5);
   ASSERT_EQ(g.fine.size(), 3u);
   for (int k = 0; k < 3; ++k) {
@@ -21,23 +18,20 @@ TEST(ReferenceGrids, TheEGridAndTheShiftedFineGrids) {
     EXPECT_NEAR(g.fine[std::size_t(k)].minCorner().x(),
                 g.fine[0].minCorner().x() - k / 3.0 * 0.25, 1e-9);
   }
-  refine.enabled = false;
-  EXPECT_TRUE(buildReferenceGrids(ref, edge(0.5), refine, 2).fine.empty());
+  EXPECT_TRUE(buildReferenceGrids(ref, edge(0.5), 0, 0.5, 2).fine.empty());
 }
 
 TEST(ReferenceGrids, AnErrorInAnyGridIsThrown) {
   PointArray ref = cornerScene(100, 6);
   ref.push_back(1e6f, 1e6f, 1e6f);  // absurd extent
-  RefineSettings refine;
-  EXPECT_THROW(buildReferenceGrids(ref, edge(0.5), refine, 2), CubeGridError);
+  EXPECT_THROW(buildReferenceGrids(ref, edge(0.5), 3, 0.5, 2), CubeGridError);
 }
 
 TEST(GridWorkspace, ARetargetedWorkspaceGivesTheJOfAFreshOne) {
   const PointArray a = cornerScene(3000, 7), b = cornerScene(5000, 8);
-  RefineSettings refine;
-  const ReferenceGrids ga = buildReferenceGrids(a, edge(0.5), refine, 1);
-  refine.grids = 2;  // fewer fine grids: the workspace drops one
-  const ReferenceGrids gb = buildReferenceGrids(b, edge(0.4), refine, 1);
+  const ReferenceGrids ga = buildReferenceGrids(a, edge(0.5), 3, 0.5, 1);
+  // Fewer fine grids of another size: the workspace drops one and retargets the others.
+  const ReferenceGrids gb = buildReferenceGrids(b, edge(0.4), 2, 0.5, 1);
   GridWorkspace reused(ga);
   reused.retarget(gb);
   GridWorkspace fresh(gb);

@@ -7,7 +7,6 @@
 #include "cube_scan_matcher/core/coincidence_objective.h"
 #include "cube_scan_matcher/core/cube_grid.h"
 #include "cube_scan_matcher/core/point_array.h"
-#include "cube_scan_matcher/core/refine_search.h"
 
 namespace cube_scan_matcher {
 
@@ -16,10 +15,11 @@ struct ReferenceGrids {
   std::vector<CubeGrid> fine;  ///< edge edge_fraction * E, origins shifted by k/grids.
 };
 
-/// Builds the E grid and, when refine.enabled, the refine.grids fine grids of `reference`, on
-/// `threads` threads. Throws the first CubeGridError (then nothing is returned).
+/// Builds the E grid (`grid`) and `fine_grids` fine grids of edge fine_edge_fraction * E with
+/// origins shifted by k/fine_grids of a fine cube, on `threads` threads. Throws the first
+/// CubeGridError (then nothing is returned).
 ReferenceGrids buildReferenceGrids(const PointArray& reference, const CubeGridSettings& grid,
-                                   const RefineSettings& refine, int threads);
+                                   int fine_grids, double fine_edge_fraction, int threads);
 
 /// One thread's objectives: a working copy of every grid of a ReferenceGrids. Moving it to
 /// other grids (retarget) reuses its memory instead of allocating it again.
