@@ -69,7 +69,10 @@ void CubeRegistration::setSettings(const RegistrationSettings& settings) {
   settings_ = settings;
 }
 
-bool CubeRegistration::hasReference() const { return reference_ != nullptr; }
+bool CubeRegistration::hasReference() const {
+  std::lock_guard<std::mutex> lock(*mutex_);
+  return reference_ != nullptr;
+}
 
 const CubeGrid& CubeRegistration::grid() const {
   static const CubeGrid empty;
@@ -77,11 +80,16 @@ const CubeGrid& CubeRegistration::grid() const {
 }
 
 void CubeRegistration::setReference(const PointArray& reference) {
-  // All grids are built before any is replaced, so an error keeps the previous reference.
-  const RefineSettings& rs = settings_.refine;
+  // All grids are built (outside the lock, so a running align() is not held up) before any is
+  // replaced, so an error keeps the previous reference.
+  RegistrationSettings s;
+  {
+    std::lock_guard<std::mutex> lock(*mutex_);
+    s = settings_;
+  }
   auto next = std::make_unique<ReferenceGrids>(
-      buildReferenceGrids(reference, settings_.grid, rs.enabled ? rs.grids : 0,
-                          rs.edge_fraction, settings_.search.threads));
+      buildReferenceGrids(reference, s.grid, s.refine.enabled ? s.refine.grids : 0,
+                          s.refine.edge_fraction, s.search.threads));
   std::lock_guard<std::mutex> lock(*mutex_);
   // The working copies move to the new grids while the old ones are still alive.
   for (auto& w : workspaces_) w->retarget(*next);
@@ -121,9 +129,9 @@ void CubeRegistration::releaseScan() const {
 }
 
 int CubeRegistration::score(const PointArray& scan, const Pose6& pose) const {
+  std::lock_guard<std::mutex> lock(*mutex_);
   if (!reference_) throw std::logic_error("CubeRegistration::score before setReference");
   if (scan.empty()) return 0;
-  std::lock_guard<std::mutex> lock(*mutex_);
   prepareWorkspaces(1);
   PointArray storage;
   CoincidenceObjective& objective = workspaces_[0]->coarse;
@@ -192,11 +200,13 @@ RegistrationResult CubeRegistration::align(const PointArray& scan, const Pose6& 
     res.time_s = seconds(start, Clock::now());
     return res;
   };
+  // Everything below reads the reference and the workspaces: under the lock, so that a
+  // concurrent setReference() waits instead of freeing the grids under this call.
+  std::lock_guard<std::mutex> lock(*mutex_);
   if (!reference_) return finish(RegistrationStatus::NoReference, "no reference scan set");
   res.reference_cubes = reference_->coarse.occupiedCount();
   if (scan.empty()) return finish(RegistrationStatus::EmptyScan, "scan has no valid point");
 
-  std::lock_guard<std::mutex> lock(*mutex_);
   const SearchSettings& ss = settings_.search;
   const RefineSettings& rs = settings_.refine;
   prepareWorkspaces(std::max(std::min(ss.threads, ss.starts),

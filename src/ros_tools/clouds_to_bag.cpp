@@ -128,7 +128,7 @@ int main(int argc, char** argv) {
     rosbag::Bag bag(output, rosbag::bagmode::Write);
     for (std::size_t k = 0; k < clouds.size(); ++k) {
       const ros::Time stamp(start + double(k) / rate);
-      const PointArray pts = io::toPointArray(*io::loadCloud(clouds[k]));
+      const PointArray pts = io::readCloudFile(clouds[k]);
       std_msgs::Header header;
       header.stamp = stamp;
       header.frame_id = frame;

@@ -234,12 +234,14 @@ int main(int argc, char** argv) {
     const auto bench_start = std::chrono::steady_clock::now();
     for (std::size_t p = 0; p < pairs.size(); ++p) {
       Data d;
-      d.src = loadCloud(pairs[p].source);
-      d.tgt = loadCloud(pairs[p].target);
+      const PointArray src_all = readCloudFile(pairs[p].source);
+      const PointArray tgt_all = readCloudFile(pairs[p].target);
+      d.src = toPcl(src_all);
+      d.tgt = toPcl(tgt_all);
       d.src_vox = voxelCopy(d.src, float(voxel));
       d.tgt_vox = voxelCopy(d.tgt, float(voxel));
-      d.src_pts = filterPoints(toPointArray(*d.src), filter);
-      d.tgt_pts = filterPoints(toPointArray(*d.tgt), filter);
+      d.src_pts = filterPoints(src_all, filter);
+      d.tgt_pts = filterPoints(tgt_all, filter);
       d.ref = pairs[p].T_target_source;
       std::fprintf(stderr, "pair %s: %zu -> %zu points (voxel copies %zu, %zu)\n",
                    pairs[p].name.c_str(), d.src->size(), d.tgt->size(), d.src_vox->size(),

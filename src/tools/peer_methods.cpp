@@ -1,13 +1,14 @@
 #include "peer_methods.h"
 
 #include <chrono>
+#include <cmath>
 
 #include <pcl/filters/voxel_grid.h>
 #include <pcl/registration/gicp.h>
 #include <pcl/registration/icp.h>
 #include <pcl/registration/ndt.h>
 
-namespace cube_scan_matcher::io {
+namespace cube_scan_matcher::tools {
 
 namespace {
 using Clock = std::chrono::steady_clock;
@@ -76,6 +77,19 @@ PeerResult runGicp(const Cloud::ConstPtr& source, const Cloud::ConstPtr& target,
   return r;
 }
 
+Cloud::Ptr toPcl(const PointArray& points) {
+  auto cloud = pcl::make_shared<Cloud>();
+  cloud->reserve(points.size());
+  bool dense = true;
+  for (std::size_t i = 0; i < points.size(); ++i) {
+    cloud->push_back(pcl::PointXYZ(points.x[i], points.y[i], points.z[i]));
+    dense = dense && std::isfinite(points.x[i]) && std::isfinite(points.y[i]) &&
+            std::isfinite(points.z[i]);
+  }
+  cloud->is_dense = dense;
+  return cloud;
+}
+
 Cloud::Ptr voxelCopy(const Cloud::ConstPtr& cloud, float leaf) {
   pcl::VoxelGrid<pcl::PointXYZ> vg;
   vg.setLeafSize(leaf, leaf, leaf);
@@ -85,4 +99,4 @@ Cloud::Ptr voxelCopy(const Cloud::ConstPtr& cloud, float leaf) {
   return out;
 }
 
-}  // namespace cube_scan_matcher::io
+}  // namespace cube_scan_matcher::tools

@@ -8,7 +8,9 @@
 #include <pcl/point_cloud.h>
 #include <pcl/point_types.h>
 
-namespace cube_scan_matcher::io {
+#include "cube_scan_matcher/core/point_array.h"
+
+namespace cube_scan_matcher::tools {
 
 using Cloud = pcl::PointCloud<pcl::PointXYZ>;
 
@@ -28,7 +30,10 @@ PeerResult runNdt(const Cloud::ConstPtr& source, const Cloud::ConstPtr& target,
 PeerResult runGicp(const Cloud::ConstPtr& source, const Cloud::ConstPtr& target,
                    const Eigen::Isometry3d& guess);
 
+/// The points as a PCL cloud (the peers' input).
+Cloud::Ptr toPcl(const PointArray& points);
+
 /// 0.2 m voxel-grid copy (centroids), as in the benchmark's "voxel" variants.
 Cloud::Ptr voxelCopy(const Cloud::ConstPtr& cloud, float leaf);
 
-}  // namespace cube_scan_matcher::io
+}  // namespace cube_scan_matcher::tools

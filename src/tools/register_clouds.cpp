@@ -58,9 +58,9 @@ int main(int argc, char** argv) {
     CubeRegistration reg(settings);
     FilterStats ref_stats, scan_stats;
     const PointArray ref =
-        filterPoints(io::toPointArray(*io::loadCloud(files[0])), filter, &ref_stats);
+        filterPoints(io::readCloudFile(files[0]), filter, &ref_stats);
     const PointArray scan =
-        filterPoints(io::toPointArray(*io::loadCloud(files[1])), filter, &scan_stats);
+        filterPoints(io::readCloudFile(files[1]), filter, &scan_stats);
     if (ref.empty()) throw std::runtime_error(files[0] + ": no valid point after filtering");
     if (scan.empty()) throw std::runtime_error(files[1] + ": no valid point after filtering");
     reg.setReference(ref);

@@ -231,6 +231,26 @@ TEST(Registration, ConcurrentAlignCallsGiveTheSequentialResults) {
   EXPECT_EQ(cb.J, b.J);
 }
 
+TEST(Registration, SetReferenceWhileAligningIsSafe) {
+  // align() used to read the reference before taking its lock, so a setReference() in another
+  // thread could free the grids under a running registration (ThreadSanitizer reported it).
+  const Scans a = makeScans(sim::SceneType::Urban, 3), b = makeScans(sim::SceneType::Park, 4);
+  CubeRegistration reg(RegistrationSettings{});
+  reg.setReference(a.first);
+  const Pose6 guess = isometryToPose(a.T_first_second);
+  std::thread swapper([&] {
+    for (int k = 0; k < 6; ++k) reg.setReference(k % 2 ? a.first : b.first);
+  });
+  for (int k = 0; k < 6; ++k) {
+    const RegistrationResult r = reg.align(a.second, guess);
+    EXPECT_TRUE(r.ok()) << r.message;
+    EXPECT_GT(r.reference_cubes, 0u);
+  }
+  swapper.join();
+  reg.setReference(a.first);
+  EXPECT_GT(reg.score(a.second, guess), 0);
+}
+
 TEST(Registration, SettingsAreValidated) {
   RegistrationSettings s = RegistrationSettings{};
   s.collapse_fraction = 2.0;

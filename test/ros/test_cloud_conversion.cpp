@@ -3,6 +3,10 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdint>
+#include <cstring>
+#include <stdexcept>
+#include <string>
 
 #include <sensor_msgs/point_cloud2_iterator.h>
 
@@ -21,8 +25,22 @@ sensor_msgs::PointCloud2 doubleCloud(std::size_t n) {
                          sensor_msgs::PointField::FLOAT32, "z", 1,
                          sensor_msgs::PointField::FLOAT64);
   m.resize(n);
-  sensor_msgs::PointCloud2Iterator<double> x(c, "x"), y(c, "y"), z(c, "z");
-  for (std::size_t i = 0; i < n; ++i, ++x, ++y, ++z) *x = double(i), *y = 2.0 * double(i), *z = -1.0;
+  // z sits at byte 20 of a 28-byte record: misaligned for a double, so the values are written
+  // with memcpy (a PointCloud2Iterator<double> would bind a misaligned reference: UB).
+  const auto offset = [&c](const std::string& name) {
+    for (const auto& f : c.fields) {
+      if (f.name == name) return std::size_t(f.offset);
+    }
+    throw std::logic_error("no field " + name);
+  };
+  const std::size_t ox = offset("x"), oy = offset("y"), oz = offset("z");
+  for (std::size_t i = 0; i < n; ++i) {
+    const double v[3] = {double(i), 2.0 * double(i), -1.0};
+    std::uint8_t* record = c.data.data() + i * c.point_step;
+    std::memcpy(record + ox, &v[0], sizeof(double));
+    std::memcpy(record + oy, &v[1], sizeof(double));
+    std::memcpy(record + oz, &v[2], sizeof(double));
+  }
   return c;
 }
 

@@ -89,9 +89,12 @@ class CubeRegistration {
   CubeRegistration& operator=(const CubeRegistration&) = delete;
 
   /// Builds V and L of the reference (finite points; see filters.h). Throws CubeGridError;
-  /// on error the previous reference is kept.
+  /// on error the previous reference is kept. Safe to call while another thread runs align():
+  /// the grids are built aside and swapped in between two registrations.
   void setReference(const PointArray& reference);
   bool hasReference() const;
+  /// The reference's E grid (an empty grid before setReference()). The reference is valid until
+  /// the next setReference(): do not hold it across one running in another thread.
   const CubeGrid& grid() const;
 
   /// Registers `scan` to the reference around `guess` (scan -> reference). Calls on one
