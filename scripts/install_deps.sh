@@ -17,6 +17,7 @@ PKGS=(
   python3-rospy python3-nav-msgs python3-sensor-msgs python3-geometry-msgs python3-std-srvs
   python3-tf2-ros python3-diagnostic-msgs python3-numpy
   rviz xvfb xauth imagemagick
+  clang-14 libfuzzer-14-dev
 )
 missing=()
 for p in "${PKGS[@]}"; do

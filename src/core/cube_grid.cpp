@@ -66,11 +66,12 @@ void computeCubeIndices(const GridAffine& g, const Eigen::Vector3f& dims, const 
     const float ay = a10 * px + a11 * py + a12 * pz + b1;
     const float az = a20 * px + a21 * py + a22 * pz + b2;
     const bool inside = (ax >= 0.f) & (ax < nx) & (ay >= 0.f) & (ay < ny) & (az >= 0.f) & (az < nz);
-    // Clamp before the conversion so that it is defined for every input; a >= 0 there, so
-    // truncation is floor.
-    const std::uint32_t ix = std::uint32_t(std::int32_t(std::min(std::max(ax, 0.f), nx)));
-    const std::uint32_t iy = std::uint32_t(std::int32_t(std::min(std::max(ay, 0.f), ny)));
-    const std::uint32_t iz = std::uint32_t(std::int32_t(std::min(std::max(az, 0.f), nz)));
+    // Clamp before the conversion so that it is defined for every input, NaN included
+    // (std::max(0.f, NaN) is 0: the comparison with NaN is false); a >= 0 there, so truncation
+    // is floor. A NaN coordinate is never inside (the comparisons above are false).
+    const std::uint32_t ix = std::uint32_t(std::int32_t(std::min(std::max(0.f, ax), nx)));
+    const std::uint32_t iy = std::uint32_t(std::int32_t(std::min(std::max(0.f, ay), ny)));
+    const std::uint32_t iz = std::uint32_t(std::int32_t(std::min(std::max(0.f, az), nz)));
     idx[i] = inside ? std::int32_t(ix + iy * sx + iz * sxy) : outside;
   }
 }

@@ -38,6 +38,7 @@ std::string toString(RegistrationStatus status) {
     case RegistrationStatus::Ok: return "ok";
     case RegistrationStatus::NoReference: return "no_reference";
     case RegistrationStatus::EmptyScan: return "empty_scan";
+    case RegistrationStatus::InvalidGuess: return "invalid_guess";
     case RegistrationStatus::NoOverlap: return "no_overlap";
   }
   return "unknown";
@@ -206,6 +207,9 @@ RegistrationResult CubeRegistration::align(const PointArray& scan, const Pose6& 
   if (!reference_) return finish(RegistrationStatus::NoReference, "no reference scan set");
   res.reference_cubes = reference_->coarse.occupiedCount();
   if (scan.empty()) return finish(RegistrationStatus::EmptyScan, "scan has no valid point");
+  if (!guess.allFinite()) {
+    return finish(RegistrationStatus::InvalidGuess, "initial guess has a NaN or infinite value");
+  }
 
   const SearchSettings& ss = settings_.search;
   const RefineSettings& rs = settings_.refine;

@@ -32,6 +32,11 @@ std::vector<PairEntry> readPairs(const std::string& dir) {
   const std::string file = dir + "/pairs.txt";
   std::ifstream in(file);
   if (!in) throw std::runtime_error(file + ": cannot open (is " + dir + " a dataset folder?)");
+  return parsePairs(in, file, dir);
+}
+
+std::vector<PairEntry> parsePairs(std::istream& in, const std::string& file,
+                                  const std::string& dir) {
   std::vector<PairEntry> pairs;
   std::string line;
   for (int no = 1; std::getline(in, line); ++no) {

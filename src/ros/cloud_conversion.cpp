@@ -84,6 +84,9 @@ sensor_msgs::PointCloud2 toCloud(const PointArray& points, const Eigen::Isometry
   cloud.height = 1;
   cloud.width = std::uint32_t(points.size());
   cloud.is_dense = true;
+  // No iterator on an empty cloud: its constructor takes data.front() (UBSan: a reference to
+  // null).
+  if (points.empty()) return cloud;
   sensor_msgs::PointCloud2Iterator<float> x(cloud, "x"), y(cloud, "y"), z(cloud, "z");
   const Eigen::Matrix3f R = transform.linear().cast<float>();
   const Eigen::Vector3f t = transform.translation().cast<float>();

@@ -2,6 +2,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <limits>
 
 #include "cube_scan_matcher/core/cube_grid.h"
 #include "grid_test_helpers.h"
@@ -19,6 +20,21 @@ TEST(CubeGrid, IndicesFollowEq5And6) {
   EXPECT_EQ(g.index(Eigen::Vector3f(1.2f, 2.4f, 0.6f)), 1 + 2 * 5 + 1 * 5 * 4);
   EXPECT_EQ(g.index(Eigen::Vector3f(0.49f, 0, 0)), 0);
   EXPECT_EQ(g.index(Eigen::Vector3f(0.51f, 0, 0)), 1);
+}
+
+TEST(CubeGrid, NonFinitePointsAreOutsideTheGrid) {
+  // The per-point loop converts clamped floats to integers: defined for NaN and inf too (the
+  // fuzzer found the NaN case undefined before the clamp was reordered).
+  PointArray p;
+  p.push_back(0, 0, 0);
+  p.push_back(4, 3, 2);
+  const CubeGrid g = CubeGrid::build(p, edge(1.0));
+  const float nan = std::numeric_limits<float>::quiet_NaN();
+  const float inf = std::numeric_limits<float>::infinity();
+  EXPECT_EQ(g.index(Eigen::Vector3f(nan, 1, 1)), -1);
+  EXPECT_EQ(g.index(Eigen::Vector3f(1, nan, 1)), -1);
+  EXPECT_EQ(g.index(Eigen::Vector3f(inf, 1, 1)), -1);
+  EXPECT_EQ(g.index(Eigen::Vector3f(1, 1, -inf)), -1);
 }
 
 TEST(CubeGrid, UpperBoundIsInclusive) {

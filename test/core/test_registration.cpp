@@ -5,6 +5,7 @@
 
 #include <cstdio>
 #include <algorithm>
+#include <limits>
 #include <random>
 #include <string>
 #include <tuple>
@@ -165,6 +166,11 @@ TEST(Registration, BadInputsGiveAResultThatSaysSo) {
   for (int i = 0; i < 100; ++i) ref.push_back(float(i % 10), float(i / 10), 0.f);
   reg.setReference(ref);
   EXPECT_EQ(reg.align(PointArray{}, Pose6::Zero()).status, RegistrationStatus::EmptyScan);
+  Pose6 nan_guess = Pose6::Zero();
+  nan_guess[4] = std::numeric_limits<double>::quiet_NaN();
+  EXPECT_EQ(reg.align(ref, nan_guess).status, RegistrationStatus::InvalidGuess);
+  nan_guess[4] = std::numeric_limits<double>::infinity();
+  EXPECT_EQ(reg.align(ref, nan_guess).status, RegistrationStatus::InvalidGuess);
 
   PointArray far_away;
   for (int i = 0; i < 100; ++i) far_away.push_back(500.f + float(i), 500.f, 500.f);
@@ -249,6 +255,25 @@ TEST(Registration, SetReferenceWhileAligningIsSafe) {
   swapper.join();
   reg.setReference(a.first);
   EXPECT_GT(reg.score(a.second, guess), 0);
+}
+
+TEST(Registration, SetSettingsWhileAligningIsSafe) {
+  // What a dynamic_reconfigure change does during a registration: new settings from another
+  // thread take effect at the next align(), never in the middle of one.
+  const Scans a = makeScans(sim::SceneType::Urban, 3);
+  CubeRegistration reg(RegistrationSettings{});
+  reg.setReference(a.first);
+  const Pose6 guess = isometryToPose(a.T_first_second);
+  std::thread changer([&] {
+    for (int k = 0; k < 6; ++k) {
+      RegistrationSettings s;
+      s.search.starts = 1 + k % 4;
+      s.search.threads = 1 + k % 2;
+      reg.setSettings(s);
+    }
+  });
+  for (int k = 0; k < 4; ++k) EXPECT_TRUE(reg.align(a.second, guess).ok());
+  changer.join();
 }
 
 TEST(Registration, SettingsAreValidated) {

@@ -60,6 +60,15 @@ TEST(CloudConversion, RoundTripsFloat32AndAppliesTheTransform) {
   EXPECT_FLOAT_EQ(q.z[1], 0.5f);
 }
 
+TEST(CloudConversion, AnEmptyCloudRoundTrips) {
+  // toCloud used to build iterators on the empty data (UBSan: reference binding to null).
+  const sensor_msgs::PointCloud2 c =
+      toCloud(PointArray{}, Eigen::Isometry3d::Identity(), std_msgs::Header{});
+  EXPECT_EQ(c.width * c.height, 0u);
+  EXPECT_TRUE(c.data.empty());
+  EXPECT_TRUE(fromCloud(c, Eigen::Isometry3d::Identity()).empty());
+}
+
 TEST(CloudConversion, ReadsFloat64WithOtherFieldsBetween) {
   const PointArray q = fromCloud(doubleCloud(5));
   ASSERT_EQ(q.size(), 5u);

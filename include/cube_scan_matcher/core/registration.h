@@ -50,6 +50,7 @@ enum class RegistrationStatus {
   Ok,           ///< J > 0 at the result.
   NoReference,  ///< align() before setReference().
   EmptyScan,    ///< the scan has no point.
+  InvalidGuess,  ///< the initial estimate has a NaN or infinite parameter.
   NoOverlap,    ///< no scan point fell in a set cube at any evaluated pose (J = 0).
 };
 std::string toString(RegistrationStatus status);

@@ -27,5 +27,8 @@ double parseNumber(const std::string& what, const std::string& text);
 
 /// Reads DIR/pairs.txt. Throws std::runtime_error naming the file and line on bad input.
 std::vector<PairEntry> readPairs(const std::string& dir);
+/// The same from a stream: `file` labels the messages, `dir` is joined to the cloud names.
+std::vector<PairEntry> parsePairs(std::istream& in, const std::string& file,
+                                  const std::string& dir);
 
 }  // namespace cube_scan_matcher::io
