@@ -18,6 +18,7 @@ bash scripts/install_deps.sh
 export PATH=/usr/sbin:/usr/bin:/sbin:/bin:$PATH
 OUT=build-fuzz
 mkdir -p "$OUT/artifacts"
+touch "$OUT/CATKIN_IGNORE"  # build outputs, not package files (catkin_lint)
 CXX=clang++-14
 FLAGS=(-std=c++17 -g -O1 -fsanitize=fuzzer,address,undefined -fno-sanitize-recover=all
        -fno-omit-frame-pointer -Iinclude -isystem /usr/include/eigen3)
