@@ -163,7 +163,6 @@ PointArray readAsciiRecords(const std::string& name, const std::string& text, st
     float c[3];
     for (int k = 0; k < 3; ++k) {
       const std::string& s = w[index_of[k]];
-      errno = 0;
       char* stop = nullptr;
       const double v = std::strtod(s.c_str(), &stop);
       if (stop == s.c_str() || *stop != '\0') {

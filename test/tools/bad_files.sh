@@ -57,11 +57,10 @@ check_file "$WORK/missing.pcd" "no such file"
 cp "$HERE/good.pcd" "$WORK/unreadable.pcd"
 chmod 000 "$WORK/unreadable.pcd"
 if [ "$(id -u)" -eq 0 ]; then
-  # root reads any file: run the tools as 'nobody', who cannot.
-  for tool in register_clouds; do
-    run "$tool(nobody)" "$WORK/unreadable.pcd" "cannot open" \
-      setpriv --reuid=nobody --regid=nogroup --clear-groups "$BIN/$tool" "$HERE/good.pcd" "$WORK/unreadable.pcd"
-  done
+  # root reads any file: run the tool as 'nobody', who cannot.
+  run "register_clouds(nobody)" "$WORK/unreadable.pcd" "cannot open" \
+    setpriv --reuid=nobody --regid=nogroup --clear-groups "$BIN/register_clouds" \
+    "$HERE/good.pcd" "$WORK/unreadable.pcd"
 else
   run register_clouds "$WORK/unreadable.pcd" "cannot open" "$BIN/register_clouds" "$HERE/good.pcd" "$WORK/unreadable.pcd"
 fi
