@@ -21,7 +21,8 @@ void OnlineMatcher::reset() {
   registration_ = CubeRegistration(settings_.registration);
   reference_points_ = PointArray{};
   reference_pose_ = last_pose_ = Eigen::Isometry3d::Identity();
-  reference_odom_.reset();
+  anchor_.reset();
+  reference_is_anchor_ = false;
   last_stamp_.reset();
   consecutive_rejections_ = 0;
   settings_changed_ = false;
@@ -57,10 +58,13 @@ OnlineStep OnlineMatcher::process(const PointArray& points, double stamp,
   }
 
   const bool first = !registration_.hasReference();
-  step.odometry_guess = odom && reference_odom_;
-  const Eigen::Isometry3d odom_increment = step.odometry_guess
-                                               ? Eigen::Isometry3d(reference_odom_->inverse() * *odom)
-                                               : Eigen::Isometry3d::Identity();
+  step.odometry_guess = odom && anchor_;
+  Eigen::Isometry3d odom_increment = Eigen::Isometry3d::Identity();
+  if (step.odometry_guess) {
+    odom_increment = anchor_->odom.inverse() * *odom;
+    // Over references without odometry: predicted map pose, seen from the reference.
+    if (!reference_is_anchor_) odom_increment = reference_pose_.inverse() * anchor_->pose * odom_increment;
+  }
   step.guess = isometryToPose(odom_increment);
   step.increment = odom_increment;
 
@@ -84,13 +88,19 @@ OnlineStep OnlineMatcher::process(const PointArray& points, double stamp,
   step.consecutive_rejections = consecutive_rejections_;
   step.rejection_alarm = consecutive_rejections_ >= settings_.max_consecutive_rejections;
 
-  // This scan becomes the reference if it has points and its grid can be built.
-  if (!points.empty()) {
+  // This scan becomes the reference if it has points, its pose is known (or the chain has to
+  // move on) and its grid can be built.
+  const bool pose_unknown = rejected && !odom && !step.rejection_alarm;
+  if (pose_unknown && !points.empty()) {
+    if (!step.message.empty()) step.message += "; ";
+    step.message += "scan not used as reference: no odometry and the registration rejected";
+  } else if (!points.empty()) {
     try {
       registration_.setReference(points);
       reference_points_ = points;
       reference_pose_ = step.pose;
-      reference_odom_ = odom;
+      reference_is_anchor_ = odom.has_value();
+      if (odom) anchor_ = OdometryAnchor{step.pose, *odom};
       step.reference_updated = true;
     } catch (const std::exception& e) {
       if (first) step.reason = GateReason::BadReference;

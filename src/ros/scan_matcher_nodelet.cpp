@@ -211,7 +211,6 @@ void ScanMatcherNodelet::trackStamps(Scan& scan) {
     os << std::fixed << std::setprecision(3) << "time went backwards from "
        << last_stamp_->toSec() << " s to " << stamp.toSec() << " s (bag loop or clock reset)";
     resetState(os.str());
-    tf_buffer_->clear();
     scan.status.time_reset = true;
   }
   const std::uint32_t seq = scan.msg.header.seq;
@@ -229,6 +228,15 @@ bool ScanMatcherNodelet::lookupFrames(Scan& scan) {
       frame == params_.base_frame ? std::optional<Eigen::Isometry3d>(Eigen::Isometry3d::Identity())
                                   : lookup(params_.base_frame, frame, stamp, tf_error);
   scan.odom = lookup(params_.odom_frame, params_.base_frame, stamp, tf_error);
+  if (scan.status.time_reset && (!T_base_cloud || !scan.odom)) {
+    // After a jump back by more than the tf cache, the buffer refuses the new (older) tf as
+    // TF_OLD_DATA: clear it, so that tf from here on is taken, and look once more.
+    NODELET_WARN("tf buffer cleared after the time jump: %s", tf_error.c_str());
+    tf_buffer_->clear();
+    tf_error.clear();
+    if (!T_base_cloud) T_base_cloud = lookup(params_.base_frame, frame, stamp, tf_error);
+    if (!scan.odom) scan.odom = lookup(params_.odom_frame, params_.base_frame, stamp, tf_error);
+  }
   scan.status.tf_failed = !T_base_cloud || !scan.odom;
   if (scan.status.tf_failed) {
     ++tf_failures_;

@@ -100,3 +100,55 @@ TEST(OnlineMatcher, ConsecutiveRejectionsRaiseTheAlarmAndPropagateOdometry) {
   EXPECT_TRUE(s.rejection_alarm);
   EXPECT_EQ(s.consecutive_rejections, 2);
 }
+
+// A gap in the odometry: scans without it are registered from identity; the first scan with
+// odometry again is guessed from the last one that had it, carried over the accepted
+// increments in between. A scan without odometry whose registration is rejected (its pose is
+// unknown) does not become the reference.
+TEST(OnlineMatcher, OdometryGapIsBridgedFromTheLastScanWithOdometry) {
+  const sim::Scene scene = sim::Scene::generate(sim::SceneType::Urban, 8);
+  sim::MotionSettings motion;
+  motion.step_min = 0.3, motion.step_max = 0.5, motion.yaw_change_max_deg = 3.0;
+  sim::RobotMotion robot(scene, motion, 9);
+  std::mt19937_64 rng(7);
+  OnlineMatcher m{OnlineMatcherSettings{}};
+  // Odometry with a constant offset from the truth: map = odom o offset.
+  Eigen::Isometry3d offset = Eigen::Isometry3d::Identity();
+  offset.translation() = Eigen::Vector3d(5.0, -3.0, 0.2);
+  offset.linear() = rotationFromRpy(0.0, 0.0, deg2rad(30.0));
+  std::vector<Eigen::Isometry3d> truth;
+  for (int k = 0; k < 5; ++k) {
+    if (k > 0) robot.advance();
+    truth.push_back(robot.pose());
+    const bool gap = k == 2;
+    const std::optional<Eigen::Isometry3d> odom =
+        gap ? std::nullopt : std::optional<Eigen::Isometry3d>(offset * robot.pose());
+    const OnlineStep s = m.process(scanInBase(scene, robot.pose(), rng), 1.0 + k, odom);
+    EXPECT_EQ(s.odometry_guess, k > 0 && !gap) << "scan " << k;
+    EXPECT_EQ(s.reason, k == 0 ? GateReason::FirstScan : GateReason::Accepted) << s.message;
+    if (k == 3) {
+      // Guessed over scan 2 (no odometry): the guess is the true increment 2 -> 3.
+      const Eigen::Isometry3d true_increment = truth[2].inverse() * truth[3];
+      EXPECT_LT((poseToIsometry(s.guess).inverse() * true_increment).translation().norm(), 0.05);
+    }
+    // map = odom at the first scan: the pose is offset * truth throughout.
+    EXPECT_LT(translationError(s.pose, offset * robot.pose()), 0.05) << "scan " << k;
+  }
+
+  // No odometry and a rejected registration (far outside the gate): not the reference.
+  OnlineMatcherSettings tight;
+  tight.gate.max_correction_m = 1e-3;
+  tight.max_consecutive_rejections = 3;
+  m.setSettings(tight);
+  robot.advance();
+  OnlineStep s = m.process(scanInBase(scene, robot.pose(), rng), 10.0, std::nullopt);
+  EXPECT_NE(s.reason, GateReason::Accepted);
+  EXPECT_FALSE(s.reference_updated);
+  EXPECT_NE(s.message.find("not used as reference"), std::string::npos) << s.message;
+  // Once max_consecutive_rejections are reached, the chain moves on.
+  s = m.process(scanInBase(scene, robot.pose(), rng), 11.0, std::nullopt);
+  EXPECT_FALSE(s.reference_updated);
+  s = m.process(scanInBase(scene, robot.pose(), rng), 12.0, std::nullopt);
+  EXPECT_TRUE(s.rejection_alarm);
+  EXPECT_TRUE(s.reference_updated);
+}

@@ -27,57 +27,14 @@
 #include "cube_scan_matcher/ros/transforms.h"
 #include "cube_scan_matcher/sim/tilting_scanner.h"
 #include "expect_params.h"
+#include "ros_test_helpers.h"
 
 using namespace cube_scan_matcher;
+using namespace cube_scan_matcher::test;
 
 namespace {
 
 const std::string kNs = "/scan_matcher/";
-
-/// Keeps the last message of each output and counts them.
-struct Outputs {
-  std::vector<Status> status;
-  std::vector<geometry_msgs::PoseWithCovarianceStamped> pose;
-  std::vector<nav_msgs::Odometry> odom;
-  std::vector<sensor_msgs::PointCloud2> cloud;  // headers only are checked; keep small
-  nav_msgs::Path path;
-  ros::Subscriber subs[5];
-
-  explicit Outputs(ros::NodeHandle& nh) {
-    subs[0] = nh.subscribe<Status>(kNs + "status", 50, [this](const Status::ConstPtr& m) { status.push_back(*m); });
-    subs[1] = nh.subscribe<geometry_msgs::PoseWithCovarianceStamped>(
-        kNs + "pose", 50, [this](const geometry_msgs::PoseWithCovarianceStamped::ConstPtr& m) { pose.push_back(*m); });
-    subs[2] = nh.subscribe<nav_msgs::Odometry>(kNs + "odometry", 50, [this](const nav_msgs::Odometry::ConstPtr& m) { odom.push_back(*m); });
-    subs[3] = nh.subscribe<sensor_msgs::PointCloud2>(kNs + "registered_cloud", 50, [this](const sensor_msgs::PointCloud2::ConstPtr& m) {
-      sensor_msgs::PointCloud2 c;
-      c.header = m->header;
-      c.width = m->width;
-      cloud.push_back(c);
-    });
-    subs[4] = nh.subscribe<nav_msgs::Path>(kNs + "path", 5, [this](const nav_msgs::Path::ConstPtr& m) { path = *m; });
-  }
-};
-
-/// Spins until `done` or `timeout` seconds pass.
-template <typename F>
-bool waitFor(F done, double timeout) {
-  const ros::WallTime end = ros::WallTime::now() + ros::WallDuration(timeout);
-  while (ros::ok() && ros::WallTime::now() < end) {
-    ros::spinOnce();
-    if (done()) return true;
-    ros::WallDuration(0.01).sleep();
-  }
-  ros::spinOnce();
-  return done();
-}
-
-sensor_msgs::PointCloud2 makeCloud(const PointArray& pts, const std::string& frame,
-                                   const ros::Time& stamp) {
-  std_msgs::Header h;
-  h.frame_id = frame;
-  h.stamp = stamp;
-  return toCloud(pts, Eigen::Isometry3d::Identity(), h);
-}
 
 class ScanMatcherRos : public ::testing::Test {
  protected:
@@ -85,7 +42,7 @@ class ScanMatcherRos : public ::testing::Test {
   ros::Publisher cloud_pub = nh.advertise<sensor_msgs::PointCloud2>("/test_cloud", 10);
   tf2_ros::TransformBroadcaster tf_pub;
   tf2_ros::StaticTransformBroadcaster static_pub;
-  Outputs out{nh};
+  Outputs out{nh, kNs};
 
   void SetUp() override {
     ASSERT_TRUE(waitFor([&] { return cloud_pub.getNumSubscribers() > 0; }, 30.0))
@@ -267,9 +224,13 @@ TEST_F(ScanMatcherRos, BadInputKeepsTheNodeAliveAndIsReported) {
   s = send(makeCloud(good, "no_such_frame", next()));
   EXPECT_EQ(s.reason, Status::SKIPPED_NO_TF);
 
-  // Clock jumps backwards: one reset, the scan starts a new chain.
-  s = send(makeCloud(good, "base_link", stamp - ros::Duration(5.0)));
+  // Clock jumps backwards: one reset, the scan starts a new chain at its odometry.
+  stamp -= ros::Duration(5.0);
+  tf_pub.sendTransform(stampedTransform(Eigen::Isometry3d::Identity(), "odom", "base_link", stamp));
+  waitFor([] { return false; }, 0.1);
+  s = send(makeCloud(good, "base_link", stamp));
   EXPECT_TRUE(s.time_reset);
+  EXPECT_FALSE(s.tf_failed);
   EXPECT_EQ(s.reason, Status::FIRST_SCAN) << s.message;
 
   // The node is still alive and registering.

@@ -48,7 +48,10 @@ class OnlineMatcher {
 
   /// `points`: the scan in the base frame at `stamp` [s] (finite points). `odom`: T_odom_base
   /// at `stamp` when known. The first scan's pose is its odometry pose (map = odom there), or
-  /// identity without odometry.
+  /// identity without odometry. The guess is the odometry increment from the last reference
+  /// that had odometry, carried over the accepted increments since (identity without
+  /// odometry). A scan whose pose is unknown (no odometry and its registration rejected) does
+  /// not become the reference, unless max_consecutive_rejections scans in a row were rejected.
   OnlineStep process(const PointArray& points, double stamp,
                      const std::optional<Eigen::Isometry3d>& odom);
 
@@ -69,7 +72,13 @@ class OnlineMatcher {
   CubeRegistration registration_;
   PointArray reference_points_;  // kept to rebuild the grid when the cube edge changes
   Eigen::Isometry3d reference_pose_ = Eigen::Isometry3d::Identity();  // T_map_base(reference)
-  std::optional<Eigen::Isometry3d> reference_odom_;                  // T_odom_base(reference)
+  /// The last reference scan that had odometry: T_map_base and T_odom_base there. A scan with
+  /// odometry is guessed from it, also when the references since then had none (a tf gap).
+  struct OdometryAnchor {
+    Eigen::Isometry3d pose, odom;
+  };
+  std::optional<OdometryAnchor> anchor_;
+  bool reference_is_anchor_ = false;
   std::optional<double> last_stamp_;
   Eigen::Isometry3d last_pose_ = Eigen::Isometry3d::Identity();
   int consecutive_rejections_ = 0;
