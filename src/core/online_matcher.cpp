@@ -1,6 +1,8 @@
 #include "cube_scan_matcher/core/online_matcher.h"
 
+#include <algorithm>
 #include <sstream>
+#include <vector>
 #include <stdexcept>
 
 namespace cube_scan_matcher {
@@ -24,6 +26,7 @@ void OnlineMatcher::reset() {
   anchor_.reset();
   reference_is_anchor_ = false;
   last_stamp_.reset();
+  intervals_.clear();
   consecutive_rejections_ = 0;
   settings_changed_ = false;
 }
@@ -34,12 +37,26 @@ void OnlineMatcher::setSettings(const OnlineMatcherSettings& settings) {
   settings_changed_ = true;
 }
 
+double OnlineMatcher::gateScale(double stamp) const {
+  if (intervals_.empty()) return 1.0;
+  // The scan period: the lower quartile of the recent intervals (the matcher sees longer ones
+  // whenever scans are dropped; a few odd short ones do not move the quartile).
+  std::vector<double> v(intervals_.begin(), intervals_.end());
+  std::nth_element(v.begin(), v.begin() + std::ptrdiff_t(v.size() / 4), v.end());
+  const double period = v[v.size() / 4];
+  return std::clamp((stamp - reference_stamp_) / period, 1.0, kMaxGateScale);
+}
+
 OnlineStep OnlineMatcher::process(const PointArray& points, double stamp,
                                   const std::optional<Eigen::Isometry3d>& odom) {
   OnlineStep step;
   if (last_stamp_ && stamp < *last_stamp_) {
     reset();
     step.time_reset = true;
+  }
+  if (last_stamp_ && stamp > *last_stamp_) {
+    intervals_.push_back(stamp - *last_stamp_);
+    if (intervals_.size() > kIntervals) intervals_.pop_front();
   }
   last_stamp_ = stamp;
   if (settings_changed_) {
@@ -76,7 +93,11 @@ OnlineStep OnlineMatcher::process(const PointArray& points, double stamp,
   } else {
     step.registered = true;
     step.result = registration_.align(points, step.guess);
-    step.reason = gate(step.result, step.guess, settings_.gate);
+    step.gate_scale = gateScale(stamp);
+    GateSettings gate_settings = settings_.gate;
+    gate_settings.max_correction_m *= step.gate_scale;
+    gate_settings.max_correction_rad *= step.gate_scale;
+    step.reason = gate(step.result, step.guess, gate_settings);
     if (step.result.ok()) step.correction = correctionFromGuess(step.guess, step.result.pose);
     step.accepted = step.reason == GateReason::Accepted;
     if (step.accepted) step.increment = step.result.transform;
@@ -99,6 +120,7 @@ OnlineStep OnlineMatcher::process(const PointArray& points, double stamp,
       registration_.setReference(points);
       reference_points_ = points;
       reference_pose_ = step.pose;
+      reference_stamp_ = stamp;
       reference_is_anchor_ = odom.has_value();
       if (odom) anchor_ = OdometryAnchor{step.pose, *odom};
       step.reference_updated = true;
@@ -113,6 +135,7 @@ OnlineStep OnlineMatcher::process(const PointArray& points, double stamp,
   std::ostringstream os;
   os << toString(step.reason);
   if (step.registered) os << " (" << step.result.message << ")";
+  if (step.gate_scale > 1.0) os << "; correction bounds x" << step.gate_scale << " (scans missed)";
   if (!step.message.empty()) os << "; " << step.message;
   step.message = os.str();
   return step;

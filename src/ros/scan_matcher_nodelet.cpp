@@ -293,6 +293,7 @@ OnlineStep ScanMatcherNodelet::registerScan(Scan& scan) {
     status.guess[std::size_t(k)] = step.guess[k];
     status.correction[std::size_t(k)] = step.correction[k];
   }
+  status.gate_scale = step.gate_scale;
   status.odometry_guess = step.odometry_guess;
   status.reference_updated = step.reference_updated;
   status.time_reset = status.time_reset || step.time_reset;

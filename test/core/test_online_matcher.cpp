@@ -152,3 +152,30 @@ TEST(OnlineMatcher, OdometryGapIsBridgedFromTheLastScanWithOdometry) {
   EXPECT_TRUE(s.rejection_alarm);
   EXPECT_TRUE(s.reference_updated);
 }
+
+// Dropped scans make the guess span several increments, and the odometry error with them: the
+// correction bounds grow with the time since the reference, in scan periods.
+TEST(OnlineMatcher, CorrectionBoundsGrowWithTheScansTheGuessSpans) {
+  const sim::Scene scene = sim::Scene::generate(sim::SceneType::Park, 2);
+  std::mt19937_64 rng(3);
+  Eigen::Isometry3d body = Eigen::Isometry3d::Identity();
+  body.translation() = Eigen::Vector3d(2, 0.5, scene.groundHeight(2, 0.5) + 1.0);
+  const PointArray scan = scanInBase(scene, body, rng);  // the same scan: the truth is identity
+  OnlineMatcherSettings settings;
+  settings.gate.max_correction_m = 0.05;
+  OnlineMatcher m(settings);
+  Eigen::Isometry3d odom = Eigen::Isometry3d::Identity();
+  for (int k = 0; k < 4; ++k) {  // one scan per second
+    const OnlineStep s = m.process(scan, double(k), odom);
+    EXPECT_DOUBLE_EQ(s.gate_scale, 1.0);
+  }
+  odom.translation().x() = 0.1;  // 0.1 m odometry error over one period: beyond 0.05 m
+  OnlineStep s = m.process(scan, 4.0, odom);
+  EXPECT_EQ(s.reason, GateReason::CorrectionTooLarge) << s.message;
+  EXPECT_DOUBLE_EQ(s.gate_scale, 1.0);
+  odom.translation().x() = 0.0;  // 0.1 m back, over three periods (two scans dropped)
+  s = m.process(scan, 7.0, odom);
+  EXPECT_DOUBLE_EQ(s.gate_scale, 3.0);
+  EXPECT_EQ(s.reason, GateReason::Accepted) << s.message;
+  EXPECT_NE(s.message.find("bounds x3"), std::string::npos) << s.message;
+}

@@ -4,6 +4,7 @@
 // next reference.
 #pragma once
 
+#include <deque>
 #include <optional>
 #include <string>
 
@@ -34,6 +35,11 @@ struct OnlineStep {
   bool time_reset = false;         ///< time went backwards: state was reset before this scan.
   bool rejection_alarm = false;    ///< consecutive rejections >= max_consecutive_rejections.
   int consecutive_rejections = 0;
+  /// The gate's max_correction bounds were multiplied by this: the time since the reference
+  /// over the scan period (the lower quartile of the last 16 intervals), in [1, 10]. It is
+  /// > 1 when scans were dropped or skipped: the odometry error grows with every increment
+  /// the guess spans.
+  double gate_scale = 1.0;
   RegistrationResult result;       ///< valid when registered.
   Pose6 guess = Pose6::Zero();     ///< scan -> reference guess [m, rad].
   Pose6 correction = Pose6::Zero();  ///< guess^-1 * result [m, rad] (zero if not registered).
@@ -52,6 +58,8 @@ class OnlineMatcher {
   /// that had odometry, carried over the accepted increments since (identity without
   /// odometry). A scan whose pose is unknown (no odometry and its registration rejected) does
   /// not become the reference, unless max_consecutive_rejections scans in a row were rejected.
+  /// The gate's correction bounds grow with the time since the reference, in units of the
+  /// typical interval between scans (the median of the last ones): see OnlineStep::gate_scale.
   OnlineStep process(const PointArray& points, double stamp,
                      const std::optional<Eigen::Isometry3d>& odom);
 
@@ -67,6 +75,7 @@ class OnlineMatcher {
   const Eigen::Isometry3d& lastPose() const { return last_pose_; }
 
  private:
+  double gateScale(double stamp) const;
   OnlineMatcherSettings settings_;
   bool settings_changed_ = false;
   CubeRegistration registration_;
@@ -80,6 +89,10 @@ class OnlineMatcher {
   std::optional<OdometryAnchor> anchor_;
   bool reference_is_anchor_ = false;
   std::optional<double> last_stamp_;
+  double reference_stamp_ = 0.0;
+  std::deque<double> intervals_;  // [s] between consecutive scans, the last kIntervals
+  static constexpr std::size_t kIntervals = 16;
+  static constexpr double kMaxGateScale = 10.0;
   Eigen::Isometry3d last_pose_ = Eigen::Isometry3d::Identity();
   int consecutive_rejections_ = 0;
 };
