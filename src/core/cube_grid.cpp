@@ -47,8 +47,14 @@ GridAffine CubeGrid::affine(const Eigen::Matrix3f& rotation,
 
 // The hot loop. Cloned for AVX-512/AVX2 and dispatched at load time on CPU *features* (an
 // "arch=" clone would dispatch on the Intel model name and miss AMD CPUs); `omp simd` (with
-// -fopenmp-simd, no OpenMP runtime) makes GCC vectorise it at -O2.
-__attribute__((target_clones("default", "avx2", "avx512f")))
+// -fopenmp-simd, no OpenMP runtime) makes GCC vectorise it at -O2. Clones exist only for x86:
+// elsewhere (aarch64: NEON is the baseline) the one portable version is compiled.
+#if defined(__x86_64__) && defined(__GNUC__) && !defined(CSM_NO_TARGET_CLONES)
+#define CSM_X86_CLONES __attribute__((target_clones("default", "avx2", "avx512f")))
+#else
+#define CSM_X86_CLONES
+#endif
+CSM_X86_CLONES
 void computeCubeIndices(const GridAffine& g, const Eigen::Vector3f& dims, const float* x,
                         const float* y, const float* z, std::size_t n, std::int32_t outside,
                         std::int32_t* idx) {

@@ -1,6 +1,7 @@
 #include "cube_scan_matcher/core/online_matcher.h"
 
 #include <algorithm>
+#include <cmath>
 #include <sstream>
 #include <vector>
 #include <stdexcept>
@@ -28,13 +29,25 @@ void OnlineMatcher::reset() {
   last_stamp_.reset();
   intervals_.clear();
   consecutive_rejections_ = 0;
-  settings_changed_ = false;
 }
 
 void OnlineMatcher::setSettings(const OnlineMatcherSettings& settings) {
   validate(settings);
+  if (registration_.hasReference()) {
+    // Build the reference's grids with the new settings first: settings whose grids cannot be
+    // built (the memory cap) throw here and leave the matcher as it was.
+    CubeRegistration rebuilt(settings.registration);
+    try {
+      rebuilt.setReference(reference_points_);
+    } catch (const std::exception& e) {
+      throw std::invalid_argument(std::string("the current reference cannot be built with these "
+                                              "settings: ") + e.what());
+    }
+    registration_ = std::move(rebuilt);
+  } else {
+    registration_.setSettings(settings.registration);
+  }
   settings_ = settings;
-  settings_changed_ = true;
 }
 
 double OnlineMatcher::gateScale(double stamp) const {
@@ -44,7 +57,8 @@ double OnlineMatcher::gateScale(double stamp) const {
   std::vector<double> v(intervals_.begin(), intervals_.end());
   std::nth_element(v.begin(), v.begin() + std::ptrdiff_t(v.size() / 4), v.end());
   const double period = v[v.size() / 4];
-  return std::clamp((stamp - reference_stamp_) / period, 1.0, kMaxGateScale);
+  // Whole periods: timing jitter does not widen the bounds, a missed scan does.
+  return std::clamp(std::round((stamp - reference_stamp_) / period), 1.0, kMaxGateScale);
 }
 
 OnlineStep OnlineMatcher::process(const PointArray& points, double stamp,
@@ -59,21 +73,6 @@ OnlineStep OnlineMatcher::process(const PointArray& points, double stamp,
     if (intervals_.size() > kIntervals) intervals_.pop_front();
   }
   last_stamp_ = stamp;
-  if (settings_changed_) {
-    // New settings: a new cube edge or refine grid needs the reference grid rebuilt.
-    settings_changed_ = false;
-    const bool had = registration_.hasReference();
-    registration_.setSettings(settings_.registration);
-    if (had) {
-      try {
-        registration_.setReference(reference_points_);
-      } catch (const std::exception& e) {
-        // Keeps the grid built with the old settings; the next scan replaces it.
-        step.message = std::string("reference not rebuilt with the new settings: ") + e.what();
-      }
-    }
-  }
-
   const bool first = !registration_.hasReference();
   step.odometry_guess = odom && anchor_;
   Eigen::Isometry3d odom_increment = Eigen::Isometry3d::Identity();
@@ -102,7 +101,10 @@ OnlineStep OnlineMatcher::process(const PointArray& points, double stamp,
     step.accepted = step.reason == GateReason::Accepted;
     if (step.accepted) step.increment = step.result.transform;
   }
-  if (!first) step.pose = reference_pose_ * step.increment;
+  if (!first) {
+    step.pose = reference_pose_ * step.increment;
+    step.interval = stamp - reference_stamp_;
+  }
 
   const bool rejected = !first && !step.accepted;
   consecutive_rejections_ = rejected ? consecutive_rejections_ + 1 : 0;

@@ -132,6 +132,9 @@ NodeParams loadParams(const ros::NodeHandle& pnh) {
   }
   p.skip_without_tf = policy == "skip";
   p.publish_tf = getBool(pnh, "publish_tf", p.publish_tf);
+  p.transform_tolerance =
+      readParam(pnh, "transform_tolerance", p.transform_tolerance, 0.0, 10.0, "s");
+  p.tf_rate = readParam(pnh, "tf_rate", p.tf_rate, 0.1, 1000.0, "Hz");
   p.queue_size = readParam(pnh, "queue_size", p.queue_size, 1, 100);
   p.path_max_length = readParam(pnh, "path_max_length", p.path_max_length, 1, 1000000);
   p.filter.min_range = readParam(pnh, "min_range", p.filter.min_range, 0.0, 1e4, "m");

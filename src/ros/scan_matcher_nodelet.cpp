@@ -1,6 +1,7 @@
 #include "cube_scan_matcher/ros/scan_matcher_nodelet.h"
 
 #include <algorithm>
+#include <cmath>
 #include <iomanip>
 #include <sstream>
 
@@ -67,7 +68,11 @@ void ScanMatcherNodelet::onInit() {
 
   tf_buffer_ = std::make_unique<tf2_ros::Buffer>(ros::Duration(60.0));
   tf_listener_ = std::make_unique<tf2_ros::TransformListener>(*tf_buffer_, nh);
-  if (params_.publish_tf) tf_broadcaster_ = std::make_unique<tf2_ros::TransformBroadcaster>();
+  if (params_.publish_tf) {
+    tf_broadcaster_ = std::make_unique<tf2_ros::TransformBroadcaster>();
+    tf_timer_ = nh.createTimer(ros::Duration(1.0 / params_.tf_rate),
+                               [this](const ros::TimerEvent&) { sendMapOdom(); });
+  }
 
   pose_pub_ = pnh.advertise<geometry_msgs::PoseWithCovarianceStamped>("pose", 10);
   odom_pub_ = pnh.advertise<nav_msgs::Odometry>("odometry", 10);
@@ -95,11 +100,16 @@ void ScanMatcherNodelet::onInit() {
 
 void ScanMatcherNodelet::reconfigure(ScanMatcherConfig& config, uint32_t /*level*/) {
   std::lock_guard<std::mutex> lock(mutex_);
+  // Applied to a copy: a request that is invalid or whose grids cannot be built (the matcher
+  // builds the current reference with it first) leaves every setting as it was, and the reply
+  // carries the old values back.
+  NodeParams requested = params_;
   try {
-    applyConfig(config, params_);
-    matcher_->setSettings(params_.matcher);
+    applyConfig(config, requested);
+    matcher_->setSettings(requested.matcher);
+    params_ = requested;
   } catch (const std::exception& e) {
-    NODELET_ERROR("dynamic_reconfigure request refused, settings unchanged: %s", e.what());
+    NODELET_WARN("dynamic_reconfigure request refused, settings unchanged: %s", e.what());
     config = toConfig(params_);
   }
 }
@@ -141,7 +151,6 @@ std::optional<Eigen::Isometry3d> ScanMatcherNodelet::lookup(const std::string& t
 void ScanMatcherNodelet::cloudCallback(const sensor_msgs::PointCloud2ConstPtr& msg) {
   const double received = ros::WallTime::now().toSec();
   if (!initialised_) return;
-  rate_status_->tick();
   std::lock_guard<std::mutex> lock(mutex_);
   try {
     processCloud(*msg, received);
@@ -159,6 +168,7 @@ void ScanMatcherNodelet::processCloud(const sensor_msgs::PointCloud2& msg, doubl
   status.points_in = msg.width * msg.height;
   Scan scan(msg, received, status);
 
+  countArrival(scan);
   if (!checkHeader(scan)) return;
   trackStamps(scan);
   if (!lookupFrames(scan)) return;
@@ -186,6 +196,7 @@ void ScanMatcherNodelet::publishStatus(Scan& scan, GateReason reason,
   status.dropped_scans = dropped_;
   status.consecutive_rejections = consecutive_rejections_;
   status.latency = ros::WallTime::now().toSec() - scan.received;
+  status.data_age = (ros::Time::now() - scan.msg.header.stamp).toSec();
   latencies_.push_back(status.latency);
   if (latencies_.size() > 200) latencies_.pop_front();
   status_pub_.publish(status);
@@ -213,10 +224,18 @@ void ScanMatcherNodelet::trackStamps(Scan& scan) {
     resetState(os.str());
     scan.status.time_reset = true;
   }
-  const std::uint32_t seq = scan.msg.header.seq;
-  if (last_seq_ && seq > *last_seq_ + 1) dropped_ += seq - *last_seq_ - 1;
-  last_seq_ = seq;
   last_stamp_ = stamp;
+}
+
+void ScanMatcherNodelet::countArrival(Scan& scan) {
+  // Scans the subscriber queue dropped never reach this callback: they are counted from the
+  // header.seq gap, as drops and as arrivals of the input rate.
+  const std::uint32_t seq = scan.msg.header.seq;
+  std::uint32_t gap = 0;
+  if (last_seq_ && seq > *last_seq_ + 1) gap = std::min<std::uint32_t>(seq - *last_seq_ - 1, 10000);
+  last_seq_ = seq;
+  dropped_ += gap;
+  for (std::uint32_t i = 0; i <= gap; ++i) rate_status_->tick();
 }
 
 bool ScanMatcherNodelet::lookupFrames(Scan& scan) {
@@ -329,7 +348,22 @@ void ScanMatcherNodelet::publishPose(const Scan& scan, const OnlineStep& step) {
   odometry.header = header;
   odometry.child_frame_id = params_.base_frame;
   odometry.pose = pose.pose;
-  odometry.twist.covariance[0] = -1.0;  // no twist estimate
+  if (step.accepted && step.interval > 0.0) {
+    // Mean velocity over the increment, in base_frame at this scan: v = R^T t / dt, w = theta / dt.
+    const Eigen::Matrix3d Rt = step.increment.linear().transpose();
+    const Eigen::Vector3d v = Rt * step.increment.translation() / step.interval;
+    const Eigen::AngleAxisd aa(step.increment.linear());
+    const Eigen::Vector3d w = Rt * (aa.axis() * aa.angle()) / step.interval;
+    odometry.twist.twist.linear.x = v.x(), odometry.twist.twist.linear.y = v.y();
+    odometry.twist.twist.linear.z = v.z();
+    odometry.twist.twist.angular.x = w.x(), odometry.twist.twist.angular.y = w.y();
+    odometry.twist.twist.angular.z = w.z();
+    // Two pose errors over the interval.
+    odometry.twist.covariance = covariance(std::sqrt(2.0) * params_.sigma_translation / step.interval,
+                                           std::sqrt(2.0) * params_.sigma_rotation / step.interval);
+  } else {
+    odometry.twist.covariance[0] = -1.0;  // no twist estimate for this scan
+  }
   odom_pub_.publish(odometry);
 
   geometry_msgs::PoseStamped path_pose;
@@ -347,10 +381,29 @@ void ScanMatcherNodelet::publishPose(const Scan& scan, const OnlineStep& step) {
 
   if (tf_broadcaster_ && scan.odom) {
     // REP-105: map -> odom such that map -> odom -> base_link equals the registered pose.
-    tf_broadcaster_->sendTransform(stampedTransform(step.pose * scan.odom->inverse(),
-                                                    params_.map_frame, params_.odom_frame,
-                                                    header.stamp));
+    bool first;
+    {
+      std::lock_guard<std::mutex> lock(tf_mutex_);
+      first = !map_odom_;
+      map_odom_ = step.pose * scan.odom->inverse();
+    }
+    // The first one also at the scan's stamp: valid from there, not only from now + tolerance.
+    if (first) {
+      tf_broadcaster_->sendTransform(stampedTransform(*map_odom_, params_.map_frame,
+                                                      params_.odom_frame, header.stamp));
+    }
+    sendMapOdom();
   }
+}
+
+void ScanMatcherNodelet::sendMapOdom() {
+  std::lock_guard<std::mutex> lock(tf_mutex_);
+  if (!map_odom_ || !tf_broadcaster_) return;
+  // Valid from now until the next update: post-dated so that lookups at the current time (a
+  // costmap, a planner) do not need to extrapolate.
+  tf_broadcaster_->sendTransform(stampedTransform(
+      *map_odom_, params_.map_frame, params_.odom_frame,
+      ros::Time::now() + ros::Duration(params_.transform_tolerance)));
 }
 
 void ScanMatcherNodelet::diagnose(diagnostic_updater::DiagnosticStatusWrapper& stat) {

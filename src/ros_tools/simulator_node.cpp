@@ -3,6 +3,8 @@
 // simulated DGPS/IMU (with configurable errors), the assembled cloud in the scanner frame at
 // the same stamp, and the exact pose on ~ground_truth (frame map = the world, which equals odom
 // at the first sweep). The static base_link -> scanner mount is published once.
+#include <mutex>
+#include <optional>
 #include <random>
 
 #include <geometry_msgs/PoseStamped.h>
@@ -81,6 +83,17 @@ int main(int argc, char** argv) {
     ROS_INFO("simulator: %s scene (seed %d), %d x %d beams, odometry errors '%s', a sweep every %.2f s",
              scene_name.c_str(), seed, model.phiCount(), model.psiCount(), odom_mode.c_str(), period);
 
+    // Odometry as a robot's: odom -> base_link at 50 Hz, stamped now, holding the last sweep's
+    // pose between sweeps (the robot moves in steps), so that tf is there at the current time.
+    std::mutex odom_mutex;
+    std::optional<Eigen::Isometry3d> last_odom;
+    ros::Timer odom_timer = nh.createTimer(ros::Duration(0.02), [&](const ros::TimerEvent&) {
+      std::lock_guard<std::mutex> lock(odom_mutex);
+      if (last_odom) tf_pub.sendTransform(stampedTransform(*last_odom, odom_frame, base_frame, ros::Time::now()));
+    });
+    ros::AsyncSpinner spinner(1);
+    spinner.start();
+
     const ros::WallTime wait_end = ros::WallTime::now() + ros::WallDuration(wait_for_subscriber);
     while (ros::ok() && cloud_pub.getNumSubscribers() == 0 && ros::WallTime::now() < wait_end) {
       ros::WallDuration(0.05).sleep();
@@ -94,8 +107,13 @@ int main(int argc, char** argv) {
       sim::SweepOptions options;
       options.keep_invalid = organized;
       const PointArray pts = sim::scan(scene, model, truth * mount, rng, options);
-      const ros::Time stamp = ros::Time::now();
-      tf_pub.sendTransform(stampedTransform(odom, odom_frame, base_frame, stamp));
+      ros::Time stamp;
+      {
+        std::lock_guard<std::mutex> lock(odom_mutex);
+        stamp = ros::Time::now();
+        last_odom = odom;
+        tf_pub.sendTransform(stampedTransform(odom, odom_frame, base_frame, stamp));
+      }
       geometry_msgs::PoseStamped gt;
       gt.header.stamp = stamp;
       gt.header.frame_id = map_frame;
@@ -107,11 +125,10 @@ int main(int argc, char** argv) {
       header.frame_id = scanner_frame;
       cloud_pub.publish(organized ? organised(pts, model.phiCount(), model.psiCount(), header)
                                   : toCloud(pts, Eigen::Isometry3d::Identity(), header));
-      ros::spinOnce();
       rate.sleep();
     }
     ROS_INFO("simulator: %d sweeps published", sweeps);
-    ros::spin();  // keep tf and topics alive until stopped
+    ros::waitForShutdown();  // keep tf and topics alive until stopped
   } catch (const std::exception& e) {
     ROS_FATAL("simulator: %s", e.what());
     return 1;

@@ -40,21 +40,31 @@ SweepEvaluator::SweepEvaluator(ros::NodeHandle& nh, const std::string& truth_top
 }
 
 void SweepEvaluator::update() {
-  // Rows are emitted in stamp order, each once its sweep and the previous one are complete.
+  // Rows are emitted in stamp order, each once its sweep is complete. A sweep the matcher
+  // never answered while a later one was (dropped by its queue) gets a "dropped" row, and the
+  // next increment is measured from the last sweep that has a pose.
   while (true) {
     const std::size_t next = rows_.size();
     if (sweeps_.size() <= next) return;
     auto it = std::next(sweeps_.begin(), std::ptrdiff_t(next));
     const Sweep& s = it->second;
-    if (!(s.has_truth && s.has_pose && s.has_status)) return;
     SweepRow row;
     row.sweep = int(next);
     row.stamp = it->first;
+    if (!(s.has_truth && s.has_pose && s.has_status)) {
+      const bool answered_later = std::any_of(std::next(it), sweeps_.end(), [](const auto& kv) {
+        return kv.second.has_status && kv.second.has_pose;
+      });
+      if (!(s.has_truth && !s.has_status && answered_later)) return;
+      row.reason = "dropped";
+      rows_.push_back(row);
+      continue;
+    }
     row.reason = s.status.reason_text;
     row.accepted = s.status.accepted;
     row.latency = s.status.latency;
-    if (next > 0) {
-      const Sweep& p = std::prev(it)->second;
+    if (last_posed_) {
+      const Sweep& p = sweeps_.at(*last_posed_);
       const Eigen::Isometry3d true_inc = p.truth.inverse() * s.truth;
       Pose6 g;
       for (int k = 0; k < 6; ++k) g[k] = s.status.guess[std::size_t(k)];
@@ -65,6 +75,7 @@ void SweepEvaluator::update() {
       row.inc_es = ei.es_m, row.inc_ea = ei.ea_deg;
       row.acc_es = ea.es_m, row.acc_ea = ea.ea_deg;
     }
+    last_posed_ = it->first;
     rows_.push_back(row);
   }
 }
@@ -88,8 +99,10 @@ std::string SweepEvaluator::format(const SweepRow& r) {
 std::string SweepEvaluator::summary() const {
   std::vector<double> es, ea, lat;
   int ok = 0, accepted = 0;
+  int dropped = 0;
   for (const SweepRow& r : rows_) {
-    if (r.sweep == 0) continue;
+    if (r.reason == "dropped") ++dropped;
+    if (r.sweep == 0 || r.reason == "dropped") continue;
     es.push_back(r.inc_es);
     ea.push_back(r.inc_ea);
     lat.push_back(r.latency);
@@ -97,6 +110,8 @@ std::string SweepEvaluator::summary() const {
     accepted += r.accepted;
   }
   if (es.empty()) return "summary: no registered sweep";
+  const SweepRow& last = *std::find_if(rows_.rbegin(), rows_.rend(),
+                                       [](const SweepRow& r) { return r.reason != "dropped"; });
   auto med = [](std::vector<double> v) {
     std::sort(v.begin(), v.end());
     return v[v.size() / 2];
@@ -105,10 +120,10 @@ std::string SweepEvaluator::summary() const {
   std::snprintf(buf, sizeof buf,
                 "summary over %zu increments: Es median %.3f m (max %.3f), Ea median %.3f deg "
                 "(max %.3f), success (Es < 0.10 m, Ea < 1 deg) %d/%zu, accepted %d/%zu, final "
-                "pose error %.3f m / %.3f deg, latency median %.3f s",
+                "pose error %.3f m / %.3f deg, latency median %.3f s, %d dropped",
                 es.size(), med(es), *std::max_element(es.begin(), es.end()), med(ea),
                 *std::max_element(ea.begin(), ea.end()), ok, es.size(), accepted, es.size(),
-                rows_.back().acc_es, rows_.back().acc_ea, med(lat));
+                last.acc_es, last.acc_ea, med(lat), dropped);
   return buf;
 }
 

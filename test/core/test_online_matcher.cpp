@@ -179,3 +179,28 @@ TEST(OnlineMatcher, CorrectionBoundsGrowWithTheScansTheGuessSpans) {
   EXPECT_EQ(s.reason, GateReason::Accepted) << s.message;
   EXPECT_NE(s.message.find("bounds x3"), std::string::npos) << s.message;
 }
+
+// Settings whose grids cannot be built for the current reference are refused at once, and the
+// matcher goes on with the old ones (a live cube_edge far too small must not stop it).
+TEST(OnlineMatcher, SettingsWhoseGridsCannotBeBuiltAreRefusedAndTheOldOnesStay) {
+  const sim::Scene scene = sim::Scene::generate(sim::SceneType::Hall, 2);
+  std::mt19937_64 rng(3);
+  Eigen::Isometry3d body = Eigen::Isometry3d::Identity();
+  body.translation() = Eigen::Vector3d(2, 0.5, 1.0);
+  const PointArray scan = scanInBase(scene, body, rng);
+  OnlineMatcherSettings settings;
+  settings.registration.grid.max_cubes = std::uint64_t{1} << 24;
+  OnlineMatcher m(settings);
+  EXPECT_EQ(m.process(scan, 1.0, std::nullopt).reason, GateReason::FirstScan);
+  OnlineMatcherSettings tiny = settings;
+  tiny.registration.grid.cube_edge = 0.05;  // millions of cubes over the hall: beyond the cap
+  EXPECT_THROW(m.setSettings(tiny), std::invalid_argument);
+  EXPECT_EQ(m.settings().registration.grid.cube_edge, settings.registration.grid.cube_edge);
+  const OnlineStep s = m.process(scan, 2.0, std::nullopt);
+  EXPECT_EQ(s.reason, GateReason::Accepted) << s.message;
+  // A good change is built at once and used.
+  OnlineMatcherSettings finer = settings;
+  finer.registration.grid.cube_edge = 0.3;
+  EXPECT_NO_THROW(m.setSettings(finer));
+  EXPECT_EQ(m.process(scan, 3.0, std::nullopt).reason, GateReason::Accepted);
+}

@@ -1,12 +1,15 @@
 // rostest of the whole demo chain in one scene: simulator_node -> ScanMatcherNodelet ->
 // SweepEvaluator, with the paper's "big" odometry errors (+-1 m, +-8 deg per increment).
 // Every increment must be within 5 cm / 0.5 deg of the truth, every sweep accepted, and
-// status and registered_cloud published for each sweep.
+// status and registered_cloud published for each sweep. While the demo runs, map -> base_link
+// must be available at the current time within 0.1 s (map -> odom post-dated, as a navigation
+// stack needs).
 #include <gtest/gtest.h>
 
 #include <cstdio>
 
 #include <ros/ros.h>
+#include <tf2_ros/transform_listener.h>
 
 #include "cube_scan_matcher/ros_tools/sweep_evaluator.h"
 
@@ -16,9 +19,26 @@ TEST(DemoScene, EveryIncrementMatchesTheTruth) {
   ros::NodeHandle nh, pnh("~");
   const int sweeps = pnh.param("sweeps", 5);
   SweepEvaluator evaluator(nh, "ground_truth", "scan_matcher");
+  tf2_ros::Buffer tf_buffer;
+  tf2_ros::TransformListener tf_listener(tf_buffer);
+  int lookups = 0, lookups_ok = 0;
+  std::string lookup_error;
+  ros::WallTime next_lookup = ros::WallTime::now();
   const ros::WallTime end = ros::WallTime::now() + ros::WallDuration(pnh.param("timeout", 120.0));
   while (ros::ok() && int(evaluator.rows().size()) < sweeps && ros::WallTime::now() < end) {
     ros::spinOnce();
+    if (!evaluator.rows().empty() && ros::WallTime::now() >= next_lookup) {
+      // As a costmap would: map -> base_link at the current time, waiting at most 0.1 s (the
+      // odometry comes at 50 Hz, so its latest is up to 20 ms old).
+      ++lookups;
+      std::string error;
+      if (tf_buffer.canTransform("map", "base_link", ros::Time::now(), ros::Duration(0.1), &error)) {
+        ++lookups_ok;
+      } else {
+        lookup_error = error;
+      }
+      next_lookup += ros::WallDuration(0.25);
+    }
     ros::WallDuration(0.02).sleep();
   }
   ros::WallDuration(0.3).sleep();
@@ -28,6 +48,9 @@ TEST(DemoScene, EveryIncrementMatchesTheTruth) {
   std::printf("%s\n", evaluator.summary().c_str());
   ASSERT_EQ(int(evaluator.rows().size()), sweeps) << "not every sweep was evaluated in time";
   EXPECT_GE(evaluator.registeredClouds(), sweeps);
+  std::printf("map -> base_link at the current time: %d of %d lookups\n", lookups_ok, lookups);
+  EXPECT_GE(lookups, 8);
+  EXPECT_EQ(lookups_ok, lookups) << "last error: " << lookup_error;
   for (const auto& r : evaluator.rows()) {
     EXPECT_GT(evaluator.cloudPoints(r.stamp), 1000u) << "sweep " << r.sweep << ": no registered_cloud";
     if (r.sweep == 0) {

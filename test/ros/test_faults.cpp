@@ -15,6 +15,7 @@
 #include <random>
 #include <thread>
 
+#include <diagnostic_msgs/DiagnosticArray.h>
 #include <dynamic_reconfigure/Reconfigure.h>
 #include <sensor_msgs/point_cloud2_iterator.h>
 #include <std_srvs/Trigger.h>
@@ -25,12 +26,14 @@
 
 #include "cube_scan_matcher/core/pose.h"
 #include "cube_scan_matcher/ros/transforms.h"
+#include "cube_scan_matcher/ros_tools/sweep_evaluator.h"
 #include "cube_scan_matcher/sim/motion.h"
 #include "cube_scan_matcher/sim/tilting_scanner.h"
 #include "ros_test_helpers.h"
 
 using namespace cube_scan_matcher;
 using namespace cube_scan_matcher::test;
+using cube_scan_matcher::SweepEvaluator;
 
 namespace {
 
@@ -167,16 +170,21 @@ class Faults : public ::testing::Test {
     EXPECT_LT(rad2deg(Eigen::AngleAxisd(e.linear()).angle()), kMaxErrorDeg) << "sweep " << k;
   }
 
-  /// map -> odom (published by the matcher) times odom -> base_link equals the pose, at `stamp`.
-  void expectTfChainMatchesPose(const ros::Time& stamp) {
-    ASSERT_TRUE(waitFor([&] { return tf_buffer.canTransform("map", "base_link", stamp); }, 5.0))
-        << "no map -> base_link at the scan's stamp";
-    const Eigen::Isometry3d via_tf =
-        tf2::transformToEigen(tf_buffer.lookupTransform("map", "base_link", stamp));
-    ASSERT_NE(out.poseAt(stamp), nullptr);
+  /// map -> odom (published by the matcher, post-dated by transform_tolerance) looked up at
+  /// the current time, times sweep k's odometry, equals the pose published for sweep k.
+  void expectMapOdomNowMatchesPose(int k, const ros::Time& stamp) {
+    ASSERT_TRUE(waitFor([&] { return out.poseAt(stamp) != nullptr; }, 5.0));
+    spinFor(0.3);  // the timer's sends after this scan's update
+    const ros::Time now = ros::Time::now();
+    ASSERT_TRUE(waitFor([&] { return tf_buffer.canTransform("map", "odom", now); }, 2.0))
+        << "no map -> odom at the current time";
+    const Eigen::Isometry3d map_odom =
+        tf2::transformToEigen(tf_buffer.lookupTransform("map", "odom", now));
     Eigen::Isometry3d pose;
     tf2::fromMsg(out.poseAt(stamp)->pose.pose, pose);
-    EXPECT_LT((via_tf.inverse() * pose).translation().norm(), 1e-6);
+    const Eigen::Isometry3d e = (map_odom * drive.odom[std::size_t(k)]).inverse() * pose;
+    EXPECT_LT(e.translation().norm(), 1e-6);
+    EXPECT_LT(Eigen::AngleAxisd(e.linear()).angle(), 1e-6);
   }
 };
 
@@ -237,12 +245,33 @@ TEST_F(Faults, OdometryTfMissingForTwoSecondsThenResumes) {
     EXPECT_LT(e.translation().norm(), kMaxErrorM) << "increment 7 -> " << k;
     EXPECT_LT(rad2deg(Eigen::AngleAxisd(e.linear()).angle()), kMaxErrorDeg) << "increment 7 -> " << k;
   }
-  expectTfChainMatchesPose(stampOf(9));
+  expectMapOdomNowMatchesPose(9, stampOf(9));
 }
 
+/// "Events since startup" of the matcher's "input rate" diagnostic, from the last /diagnostics.
+struct InputRateEvents {
+  int events = -1;
+  ros::Subscriber sub;
+  explicit InputRateEvents(ros::NodeHandle& nh) {
+    sub = nh.subscribe<diagnostic_msgs::DiagnosticArray>(
+        "/diagnostics", 20, [this](const diagnostic_msgs::DiagnosticArray::ConstPtr& m) {
+          for (const auto& st : m->status) {
+            if (st.name.find("scan_matcher: input rate") == std::string::npos) continue;
+            for (const auto& kv : st.values) {
+              if (kv.key == "Events since startup") events = std::stoi(kv.value);
+            }
+          }
+        });
+  }
+};
+
 TEST_F(Faults, BurstOfFiftyCloudsIsProcessedOrCountedAsDropped) {
+  InputRateEvents rate(nh);
   sendSweep(0, stampOf(0));
   const Status before = sendSweep(1, stampOf(1));
+  ASSERT_TRUE(waitFor([&] { return rate.events >= 0; }, 5.0)) << "no input rate diagnostic";
+  spinFor(1.2);  // the next diagnostics update
+  const int events_before = rate.events;
   // 50 clouds back to back, alternating between sweeps 2 and 3, each with its odometry.
   constexpr int kBurst = 50;
   auto sweepOf = [](int i) { return 2 + i % 2; };
@@ -267,6 +296,9 @@ TEST_F(Faults, BurstOfFiftyCloudsIsProcessedOrCountedAsDropped) {
   EXPECT_EQ(processed + dropped, kBurst) << processed << " processed, " << dropped << " dropped";
   std::printf("[faults] burst of %d: %d processed, %d dropped by the queue\n", kBurst, processed, dropped);
   EXPECT_GE(processed, 2);
+  // The input rate counts arrivals, dropped ones included.
+  EXPECT_TRUE(waitFor([&] { return rate.events >= events_before + kBurst; }, 5.0))
+      << "input rate events: " << events_before << " before the burst, " << rate.events << " after";
   // Registration goes on after the burst.
   const Status s = sendSweep(4, stampOf(8));
   EXPECT_EQ(s.reason, Status::ACCEPTED) << s.message;
@@ -391,6 +423,67 @@ TEST_F(Faults, SensorExtrinsicChangeOnTfIsFollowed) {
   const Status s = sendSweep(5, stampOf(5));
   EXPECT_EQ(s.reason, Status::ACCEPTED) << s.message;
   expectPose(5, stampOf(5));
+}
+
+// A live cube_edge of 0.01 m (clamped to the cfg's 0.05 m by dynamic_reconfigure) would give
+// refine grids far beyond max_grid_megabytes: the request is refused, the reply carries the
+// old value back, and registration goes on.
+TEST_F(Faults, LiveCubeEdgeWhoseGridsCannotBeBuiltIsRefused) {
+  for (int k = 0; k < 2; ++k) {
+    EXPECT_EQ(sendSweep(k, stampOf(k)).reason, k == 0 ? Status::FIRST_SCAN : Status::ACCEPTED);
+  }
+  dynamic_reconfigure::Reconfigure r;
+  dynamic_reconfigure::DoubleParameter edge;
+  edge.name = "cube_edge", edge.value = 0.01;
+  r.request.config.doubles = {edge};
+  ASSERT_TRUE(ros::service::call(kNs + "set_parameters", r));
+  double replied = -1.0;
+  for (const auto& d : r.response.config.doubles) {
+    if (d.name == "cube_edge") replied = d.value;
+  }
+  EXPECT_EQ(replied, 0.5);
+  for (int k = 2; k < 4; ++k) {
+    const Status s = sendSweep(k, stampOf(k));
+    EXPECT_EQ(s.reason, Status::ACCEPTED) << s.message;
+    EXPECT_LT(s.registration_time, 1.0);
+    expectPose(k, stampOf(k));
+  }
+}
+
+// The demo's evaluator (SweepEvaluator) goes on past a sweep the matcher never answered: the
+// sweep is listed as dropped and the next increment is measured from the last answered one.
+TEST(SweepEvaluatorAcrossDrops, ADroppedSweepDoesNotStopTheRows) {
+  ros::NodeHandle nh;
+  SweepEvaluator evaluator(nh, "/fake/ground_truth", "/fake/matcher");
+  auto truth_pub = nh.advertise<geometry_msgs::PoseStamped>("/fake/ground_truth", 10);
+  auto pose_pub = nh.advertise<geometry_msgs::PoseWithCovarianceStamped>("/fake/matcher/pose", 10);
+  auto status_pub = nh.advertise<Status>("/fake/matcher/status", 10);
+  ASSERT_TRUE(waitFor([&] { return status_pub.getNumSubscribers() > 0 && pose_pub.getNumSubscribers() > 0 &&
+                                   truth_pub.getNumSubscribers() > 0; }, 10.0));
+  const ros::Time t0 = ros::Time::now();
+  for (int k = 0; k < 3; ++k) {
+    const ros::Time stamp = t0 + ros::Duration(k);
+    Eigen::Isometry3d p = Eigen::Isometry3d::Identity();
+    p.translation().x() = 2.0 * k;
+    geometry_msgs::PoseStamped truth;
+    truth.header.stamp = stamp;
+    truth.pose = tf2::toMsg(p);
+    truth_pub.publish(truth);
+    if (k == 1) continue;  // dropped: no pose, no status
+    geometry_msgs::PoseWithCovarianceStamped pose;
+    pose.header.stamp = stamp;
+    pose.pose.pose = tf2::toMsg(p);
+    pose_pub.publish(pose);
+    Status status;
+    status.header.stamp = stamp;
+    status.accepted = k > 0;
+    status.reason_text = k == 0 ? "first_scan" : "accepted";
+    status_pub.publish(status);
+  }
+  ASSERT_TRUE(waitFor([&] { return evaluator.rows().size() == 3; }, 5.0)) << evaluator.rows().size() << " rows";
+  EXPECT_EQ(evaluator.rows()[1].reason, "dropped");
+  EXPECT_EQ(evaluator.rows()[2].reason, "accepted");
+  EXPECT_LT(evaluator.rows()[2].inc_es, 1e-9);  // 0 -> 2 against the truth 0 -> 2
 }
 
 // Last: the stamps jump back into the past of the other tests.

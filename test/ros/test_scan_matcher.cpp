@@ -135,6 +135,16 @@ TEST_F(ScanMatcherRos, RegistersSimulatedSweepsToTheTruth) {
     EXPECT_GT(p.pose.covariance[0], 0.0);
   }
   const auto& o = out.odom.back();
+  {
+    // Twist: the mean velocity over the last increment (0.5 s), in base_link at the scan.
+    const Eigen::Isometry3d inc = truths[1].inverse() * truths[2];
+    const Eigen::Vector3d v = inc.linear().transpose() * inc.translation() / 0.5;
+    const auto& tw = o.twist.twist;
+    EXPECT_LT((Eigen::Vector3d(tw.linear.x, tw.linear.y, tw.linear.z) - v).norm(), 0.15);
+    const Eigen::AngleAxisd aa(inc.linear());
+    EXPECT_NEAR(tw.angular.z, aa.angle() * aa.axis().z() / 0.5, 0.02);
+    EXPECT_GT(o.twist.covariance[0], 0.0);
+  }
   EXPECT_EQ(o.header.frame_id, "map");
   EXPECT_EQ(o.child_frame_id, "base_link");
   EXPECT_EQ(o.header.stamp, t0 + ros::Duration(1.5));

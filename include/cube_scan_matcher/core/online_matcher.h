@@ -36,7 +36,7 @@ struct OnlineStep {
   bool rejection_alarm = false;    ///< consecutive rejections >= max_consecutive_rejections.
   int consecutive_rejections = 0;
   /// The gate's max_correction bounds were multiplied by this: the time since the reference
-  /// over the scan period (the lower quartile of the last 16 intervals), in [1, 10]. It is
+  /// in whole scan periods (the lower quartile of the last 16 intervals), in [1, 10]. It is
   /// > 1 when scans were dropped or skipped: the odometry error grows with every increment
   /// the guess spans.
   double gate_scale = 1.0;
@@ -44,6 +44,7 @@ struct OnlineStep {
   Pose6 guess = Pose6::Zero();     ///< scan -> reference guess [m, rad].
   Pose6 correction = Pose6::Zero();  ///< guess^-1 * result [m, rad] (zero if not registered).
   Eigen::Isometry3d increment = Eigen::Isometry3d::Identity();  ///< scan -> reference, used.
+  double interval = 0.0;           ///< [s] from the reference's stamp to this scan's (0 if first).
   Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();       ///< T_map_base of this scan.
   std::string message;             ///< why, for logs.
 };
@@ -65,8 +66,10 @@ class OnlineMatcher {
 
   /// Forgets the reference, the pose chain and the rejection count.
   void reset();
-  /// Takes effect at the next scan (a new cube edge rebuilds the reference grid there).
-  void setSettings(const OnlineMatcherSettings& settings);  // validates
+  /// Takes effect at the next scan. Validates, and rebuilds the current reference's grids with
+  /// the new settings at once: throws std::invalid_argument (and keeps the old settings) when
+  /// they cannot be built, e.g. a cube edge whose grid exceeds the memory cap.
+  void setSettings(const OnlineMatcherSettings& settings);
   const OnlineMatcherSettings& settings() const { return settings_; }
   bool hasReference() const { return registration_.hasReference(); }
   /// Stamp of the last processed scan [s]; nullopt after reset.
@@ -77,7 +80,6 @@ class OnlineMatcher {
  private:
   double gateScale(double stamp) const;
   OnlineMatcherSettings settings_;
-  bool settings_changed_ = false;
   CubeRegistration registration_;
   PointArray reference_points_;  // kept to rebuild the grid when the cube edge changes
   Eigen::Isometry3d reference_pose_ = Eigen::Isometry3d::Identity();  // T_map_base(reference)

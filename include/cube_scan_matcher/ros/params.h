@@ -47,6 +47,8 @@ struct NodeParams {
   double tf_timeout = 0.1;        ///< [s] bounded wait for each tf lookup, in [0, 10].
   bool skip_without_tf = false;   ///< missing_tf_policy: "skip" (true) or "identity" (false).
   bool publish_tf = false;        ///< publish map_frame -> odom_frame (REP-105).
+  double transform_tolerance = 0.1;  ///< [s] map -> odom is post-dated by this, in [0, 10].
+  double tf_rate = 20.0;          ///< [Hz] map -> odom re-sent at this rate, in [0.1, 1000].
   // Input and outputs.
   int queue_size = 1;             ///< subscriber queue, in [1, 100].
   int path_max_length = 10000;    ///< poses kept in ~path, in [1, 1e6].

@@ -47,8 +47,9 @@ class ScanMatcherNodelet : public nodelet::Nodelet {
     std::optional<Eigen::Isometry3d> odom;  ///< T_odom_base at the stamp, if tf had it
     PointArray points;                      ///< valid points in base_frame
   };
+  void countArrival(Scan& scan);    ///< input rate and dropped scans (header.seq gaps)
   bool checkHeader(Scan& scan);     ///< a stamp and a frame
-  void trackStamps(Scan& scan);     ///< time going backwards (reset), dropped scans
+  void trackStamps(Scan& scan);     ///< time going backwards (reset)
   bool lookupFrames(Scan& scan);    ///< cloud -> base_frame and odometry at the stamp
   bool convertPoints(Scan& scan);   ///< PointCloud2 -> filtered points in base_frame
   OnlineStep registerScan(Scan& scan);  ///< the core: register, gate, chain
@@ -80,6 +81,13 @@ class ScanMatcherNodelet : public nodelet::Nodelet {
   std::unique_ptr<diagnostic_updater::FrequencyStatus> rate_status_;
   double min_rate_ = 0.0, max_rate_ = 0.0;  // FrequencyStatus keeps references to these
   ros::Timer diagnostics_timer_;
+
+  // map -> odom, sent at once after each scan and re-sent on tf_timer_, stamped
+  // now + transform_tolerance (as amcl does) so that lookups at the current time succeed.
+  void sendMapOdom();
+  std::mutex tf_mutex_;  // guards map_odom_ (the timer must not wait for a registration)
+  std::optional<Eigen::Isometry3d> map_odom_;
+  ros::Timer tf_timer_;
 
   nav_msgs::Path path_;
   std::optional<std::uint32_t> last_seq_;

@@ -5,6 +5,7 @@
 #pragma once
 
 #include <map>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -21,7 +22,7 @@ namespace cube_scan_matcher {
 struct SweepRow {
   int sweep = 0;                ///< 0 = the first (reference) sweep
   ros::Time stamp;
-  std::string reason;           ///< Status.reason_text
+  std::string reason;           ///< Status.reason_text, or "dropped" (never answered)
   bool accepted = false;
   double guess_es = 0, guess_ea = 0;  ///< odometry increment error [m], [deg]
   double inc_es = 0, inc_ea = 0;      ///< registered increment error [m], [deg]
@@ -56,6 +57,7 @@ class SweepEvaluator {
   void update();
 
   std::map<ros::Time, Sweep> sweeps_;
+  std::optional<ros::Time> last_posed_;  // the last sweep with a pose (the increments' start)
   std::vector<SweepRow> rows_;
   int clouds_ = 0;
   std::map<ros::Time, std::uint32_t> cloud_points_;
