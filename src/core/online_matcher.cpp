@@ -29,6 +29,12 @@ void OnlineMatcher::reset() {
   last_stamp_.reset();
   intervals_.clear();
   consecutive_rejections_ = 0;
+  start_pose_.reset();
+}
+
+void OnlineMatcher::restartAt(const Eigen::Isometry3d& pose) {
+  reset();
+  start_pose_ = pose;
 }
 
 void OnlineMatcher::setSettings(const OnlineMatcherSettings& settings) {
@@ -65,7 +71,10 @@ OnlineStep OnlineMatcher::process(const PointArray& points, double stamp,
                                   const std::optional<Eigen::Isometry3d>& odom) {
   OnlineStep step;
   if (last_stamp_ && stamp < *last_stamp_) {
+    // The scan period is the sensor's: it survives a bag loop or a clock reset.
+    std::deque<double> intervals = std::move(intervals_);
     reset();
+    intervals_ = std::move(intervals);
     step.time_reset = true;
   }
   if (last_stamp_ && stamp > *last_stamp_) {
@@ -86,13 +95,22 @@ OnlineStep OnlineMatcher::process(const PointArray& points, double stamp,
 
   if (first) {
     step.reason = points.empty() ? GateReason::BadInput : GateReason::FirstScan;
-    step.pose = odom ? *odom : Eigen::Isometry3d::Identity();
+    step.pose = start_pose_ ? *start_pose_ : odom ? *odom : Eigen::Isometry3d::Identity();
   } else if (points.empty()) {
     step.reason = GateReason::BadInput;
   } else {
     step.registered = true;
-    step.result = registration_.align(points, step.guess);
     step.gate_scale = gateScale(stamp);
+    if (step.gate_scale > 1.0) {
+      // The guess spans several increments: search as much wider as the gate is.
+      RegistrationSettings wide = settings_.registration;
+      wide.gnmm.bounds *= step.gate_scale;
+      registration_.setSettings(wide);
+      step.result = registration_.align(points, step.guess);
+      registration_.setSettings(settings_.registration);
+    } else {
+      step.result = registration_.align(points, step.guess);
+    }
     GateSettings gate_settings = settings_.gate;
     gate_settings.max_correction_m *= step.gate_scale;
     gate_settings.max_correction_rad *= step.gate_scale;
@@ -126,6 +144,7 @@ OnlineStep OnlineMatcher::process(const PointArray& points, double stamp,
       reference_is_anchor_ = odom.has_value();
       if (odom) anchor_ = OdometryAnchor{step.pose, *odom};
       step.reference_updated = true;
+      if (first) start_pose_.reset();
     } catch (const std::exception& e) {
       if (first) step.reason = GateReason::BadReference;
       if (!step.message.empty()) step.message += "; ";

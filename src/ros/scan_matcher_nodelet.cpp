@@ -80,6 +80,7 @@ void ScanMatcherNodelet::onInit() {
   cloud_pub_ = pnh.advertise<sensor_msgs::PointCloud2>("registered_cloud", 2);
   status_pub_ = pnh.advertise<Status>("status", 10);
   reset_srv_ = pnh.advertiseService("reset", &ScanMatcherNodelet::resetService, this);
+  set_pose_srv_ = pnh.advertiseService("set_pose", &ScanMatcherNodelet::setPoseService, this);
 
   reconfigure_server_ =
       std::make_unique<dynamic_reconfigure::Server<ScanMatcherConfig>>(reconfigure_mutex_, pnh);
@@ -122,6 +123,32 @@ bool ScanMatcherNodelet::resetService(std_srvs::Trigger::Request&, std_srvs::Tri
   return true;
 }
 
+bool ScanMatcherNodelet::setPoseService(SetPose::Request& req, SetPose::Response& res) {
+  const auto& p = req.pose.pose.pose;
+  const Eigen::Quaterniond q(p.orientation.w, p.orientation.x, p.orientation.y, p.orientation.z);
+  const Eigen::Vector3d t(p.position.x, p.position.y, p.position.z);
+  res.success = false;
+  if (!req.pose.header.frame_id.empty() && req.pose.header.frame_id != params_.map_frame) {
+    res.message = "pose must be in map_frame '" + params_.map_frame + "', not '" +
+                  req.pose.header.frame_id + "'";
+  } else if (!t.allFinite() || !q.coeffs().allFinite() || std::abs(q.norm() - 1.0) > 1e-3) {
+    res.message = "pose must be finite with a unit quaternion";
+  } else {
+    std::lock_guard<std::mutex> lock(mutex_);
+    resetState("pose set through ~set_pose");
+    Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();
+    pose.linear() = q.normalized().toRotationMatrix();
+    pose.translation() = t;
+    matcher_->restartAt(pose);
+    const auto& c = req.pose.pose.covariance;
+    start_var_ = std::make_pair((c[0] + c[7] + c[14]) / 3.0, (c[21] + c[28] + c[35]) / 3.0);
+    res.success = true;
+    res.message = "the next scan starts a new chain at the given pose";
+  }
+  if (!res.success) NODELET_WARN("~set_pose refused: %s", res.message.c_str());
+  return true;
+}
+
 void ScanMatcherNodelet::resetState(const std::string& why) {
   NODELET_WARN("%s: the next scan starts a new pose chain", why.c_str());
   if (matcher_) matcher_->reset();
@@ -130,6 +157,7 @@ void ScanMatcherNodelet::resetState(const std::string& why) {
   last_stamp_.reset();
   dropped_ = rejected_ = tf_failures_ = processed_ = bad_input_ = consecutive_rejections_ = 0;
   latencies_.clear();
+  start_var_.reset();
 }
 
 std::optional<Eigen::Isometry3d> ScanMatcherNodelet::lookup(const std::string& target,
@@ -330,9 +358,18 @@ OnlineStep ScanMatcherNodelet::registerScan(Scan& scan) {
 }
 
 void ScanMatcherNodelet::publishPose(const Scan& scan, const OnlineStep& step) {
-  const bool registered_pose = step.reason == GateReason::Accepted ||
-                               step.reason == GateReason::FirstScan;
-  const double scale = registered_pose ? 1.0 : params_.rejected_sigma_scale;
+  // Covariance along the chain: each accepted increment adds sigma^2, each one propagated by
+  // odometry (scale * sigma)^2; a chain starts at sigma^2 (or the ~set_pose covariance).
+  const double st = params_.sigma_translation, sr = deg2rad(params_.sigma_rotation);
+  if (step.reason == GateReason::FirstScan) {
+    chain_var_t_ = start_var_ && start_var_->first > 0.0 ? start_var_->first : st * st;
+    chain_var_r_ = start_var_ && start_var_->second > 0.0 ? start_var_->second : sr * sr;
+    start_var_.reset();
+  } else {
+    const double scale = step.accepted ? 1.0 : params_.rejected_sigma_scale;
+    chain_var_t_ += scale * scale * st * st;
+    chain_var_r_ += scale * scale * sr * sr;
+  }
   std_msgs::Header header;
   header.stamp = scan.msg.header.stamp;
   header.frame_id = params_.map_frame;
@@ -340,8 +377,7 @@ void ScanMatcherNodelet::publishPose(const Scan& scan, const OnlineStep& step) {
   geometry_msgs::PoseWithCovarianceStamped pose;
   pose.header = header;
   pose.pose.pose = toPoseMsg(step.pose);
-  pose.pose.covariance =
-      covariance(params_.sigma_translation * scale, params_.sigma_rotation * scale);
+  pose.pose.covariance = covariance(std::sqrt(chain_var_t_), rad2deg(std::sqrt(chain_var_r_)));
   pose_pub_.publish(pose);
 
   nav_msgs::Odometry odometry;

@@ -24,6 +24,7 @@
 #include <tf2_ros/transform_broadcaster.h>
 #include <tf2_ros/transform_listener.h>
 
+#include "cube_scan_matcher/SetPose.h"
 #include "cube_scan_matcher/core/pose.h"
 #include "cube_scan_matcher/ros/transforms.h"
 #include "cube_scan_matcher/ros_tools/sweep_evaluator.h"
@@ -448,6 +449,42 @@ TEST_F(Faults, LiveCubeEdgeWhoseGridsCannotBeBuiltIsRefused) {
     EXPECT_LT(s.registration_time, 1.0);
     expectPose(k, stampOf(k));
   }
+}
+
+// ~set_pose restarts the chain: the next scan is at the given pose with the given covariance,
+// the following ones chain from it. A pose in another frame is refused.
+TEST_F(Faults, SetPoseRestartsTheChainAtThePose) {
+  for (int k = 0; k < 2; ++k) sendSweep(k, stampOf(k));
+  SetPose srv;
+  srv.request.pose.header.frame_id = "odom";
+  ASSERT_TRUE(ros::service::call(kNs + "set_pose", srv));
+  EXPECT_FALSE(srv.response.success);
+  EXPECT_NE(srv.response.message.find("map_frame"), std::string::npos) << srv.response.message;
+
+  Eigen::Isometry3d start = Eigen::Isometry3d::Identity();
+  start.translation() = Eigen::Vector3d(100.0, -50.0, 3.0);
+  start.linear() = rotationFromRpy(0.0, 0.0, deg2rad(120.0));
+  srv.request.pose.header.frame_id = "map";
+  srv.request.pose.pose.pose = tf2::toMsg(start);
+  for (int i = 0; i < 3; ++i) srv.request.pose.pose.covariance[std::size_t(7 * i)] = 0.04;
+  ASSERT_TRUE(ros::service::call(kNs + "set_pose", srv));
+  EXPECT_TRUE(srv.response.success) << srv.response.message;
+
+  Status s = sendSweep(2, stampOf(2));
+  EXPECT_EQ(s.reason, Status::FIRST_SCAN) << s.message;
+  ASSERT_TRUE(waitFor([&] { return out.poseAt(stampOf(2)) != nullptr; }, 5.0));
+  Eigen::Isometry3d p2;
+  tf2::fromMsg(out.poseAt(stampOf(2))->pose.pose, p2);
+  EXPECT_LT((start.inverse() * p2).translation().norm(), 1e-6);
+  EXPECT_NEAR(out.poseAt(stampOf(2))->pose.covariance[0], 0.04, 1e-9);
+  s = sendSweep(3, stampOf(3));
+  EXPECT_EQ(s.reason, Status::ACCEPTED) << s.message;
+  ASSERT_TRUE(waitFor([&] { return out.poseAt(stampOf(3)) != nullptr; }, 5.0));
+  Eigen::Isometry3d p3;
+  tf2::fromMsg(out.poseAt(stampOf(3))->pose.pose, p3);
+  const Eigen::Isometry3d e = (start * drive.truth[2].inverse() * drive.truth[3]).inverse() * p3;
+  EXPECT_LT(e.translation().norm(), kMaxErrorM);
+  EXPECT_GT(out.poseAt(stampOf(3))->pose.covariance[0], 0.04);
 }
 
 // The demo's evaluator (SweepEvaluator) goes on past a sweep the matcher never answered: the

@@ -133,6 +133,9 @@ TEST_F(ScanMatcherRos, RegistersSimulatedSweepsToTheTruth) {
     EXPECT_LT(e.translation().norm(), 0.05) << "scan " << k;
     EXPECT_LT(rad2deg(Eigen::AngleAxisd(e.linear()).angle()), 0.5) << "scan " << k;
     EXPECT_GT(p.pose.covariance[0], 0.0);
+    if (k > 0) {  // the covariance grows along the chain
+      EXPECT_GT(p.pose.covariance[0], out.pose[out.pose.size() - 4 + std::size_t(k)].pose.covariance[0]);
+    }
   }
   const auto& o = out.odom.back();
   {

@@ -36,7 +36,8 @@ struct OnlineStep {
   bool rejection_alarm = false;    ///< consecutive rejections >= max_consecutive_rejections.
   int consecutive_rejections = 0;
   /// The gate's max_correction bounds were multiplied by this: the time since the reference
-  /// in whole scan periods (the lower quartile of the last 16 intervals), in [1, 10]. It is
+  /// in whole scan periods (the lower quartile of the last 16 intervals), in [1, 4]; the
+  /// GNMM restart bounds are widened by the same factor for that registration. It is
   /// > 1 when scans were dropped or skipped: the odometry error grows with every increment
   /// the guess spans.
   double gate_scale = 1.0;
@@ -59,13 +60,16 @@ class OnlineMatcher {
   /// that had odometry, carried over the accepted increments since (identity without
   /// odometry). A scan whose pose is unknown (no odometry and its registration rejected) does
   /// not become the reference, unless max_consecutive_rejections scans in a row were rejected.
-  /// The gate's correction bounds grow with the time since the reference, in units of the
-  /// typical interval between scans (the median of the last ones): see OnlineStep::gate_scale.
+  /// The gate's correction bounds and the search's restart bounds grow with the time since the
+  /// reference, in whole scan periods: see OnlineStep::gate_scale.
   OnlineStep process(const PointArray& points, double stamp,
                      const std::optional<Eigen::Isometry3d>& odom);
 
   /// Forgets the reference, the pose chain and the rejection count.
   void reset();
+  /// reset(), and the next scan starts the new chain at `pose` (T_map_base) instead of its
+  /// odometry pose.
+  void restartAt(const Eigen::Isometry3d& pose);
   /// Takes effect at the next scan. Validates, and rebuilds the current reference's grids with
   /// the new settings at once: throws std::invalid_argument (and keeps the old settings) when
   /// they cannot be built, e.g. a cube edge whose grid exceeds the memory cap.
@@ -83,6 +87,7 @@ class OnlineMatcher {
   CubeRegistration registration_;
   PointArray reference_points_;  // kept to rebuild the grid when the cube edge changes
   Eigen::Isometry3d reference_pose_ = Eigen::Isometry3d::Identity();  // T_map_base(reference)
+  std::optional<Eigen::Isometry3d> start_pose_;  // of the next first scan (restartAt)
   /// The last reference scan that had odometry: T_map_base and T_odom_base there. A scan with
   /// odometry is guessed from it, also when the references since then had none (a tf gap).
   struct OdometryAnchor {
@@ -94,7 +99,7 @@ class OnlineMatcher {
   double reference_stamp_ = 0.0;
   std::deque<double> intervals_;  // [s] between consecutive scans, the last kIntervals
   static constexpr std::size_t kIntervals = 16;
-  static constexpr double kMaxGateScale = 10.0;
+  static constexpr double kMaxGateScale = 4.0;
   Eigen::Isometry3d last_pose_ = Eigen::Isometry3d::Identity();
   int consecutive_rejections_ = 0;
 };

@@ -7,6 +7,7 @@
 #include <memory>
 #include <mutex>
 #include <optional>
+#include <utility>
 
 #include <diagnostic_updater/diagnostic_updater.h>
 #include <diagnostic_updater/update_functions.h>
@@ -20,6 +21,7 @@
 #include <tf2_ros/transform_broadcaster.h>
 #include <tf2_ros/transform_listener.h>
 
+#include "cube_scan_matcher/SetPose.h"
 #include "cube_scan_matcher/ScanMatcherConfig.h"
 #include "cube_scan_matcher/Status.h"
 #include "cube_scan_matcher/core/online_matcher.h"
@@ -58,6 +60,7 @@ class ScanMatcherNodelet : public nodelet::Nodelet {
   /// The bad-input exit: counted, logged (throttled) and published as BAD_INPUT.
   void rejectInput(Scan& scan, const std::string& why);
   bool resetService(std_srvs::Trigger::Request& req, std_srvs::Trigger::Response& res);
+  bool setPoseService(SetPose::Request& req, SetPose::Response& res);
   void reconfigure(ScanMatcherConfig& config, uint32_t level);
   /// T_target_source at `stamp`, waiting at most ~tf_timeout; nullopt (and counted) on failure.
   std::optional<Eigen::Isometry3d> lookup(const std::string& target, const std::string& source,
@@ -74,7 +77,7 @@ class ScanMatcherNodelet : public nodelet::Nodelet {
   std::unique_ptr<tf2_ros::TransformBroadcaster> tf_broadcaster_;
   ros::Subscriber cloud_sub_;
   ros::Publisher pose_pub_, odom_pub_, path_pub_, cloud_pub_, status_pub_;
-  ros::ServiceServer reset_srv_;
+  ros::ServiceServer reset_srv_, set_pose_srv_;
   std::unique_ptr<dynamic_reconfigure::Server<ScanMatcherConfig>> reconfigure_server_;
   boost::recursive_mutex reconfigure_mutex_;  // dynamic_reconfigure needs a boost mutex
   std::unique_ptr<diagnostic_updater::Updater> updater_;
@@ -88,6 +91,11 @@ class ScanMatcherNodelet : public nodelet::Nodelet {
   std::mutex tf_mutex_;  // guards map_odom_ (the timer must not wait for a registration)
   std::optional<Eigen::Isometry3d> map_odom_;
   ros::Timer tf_timer_;
+
+  // Variances [m^2], [rad^2] of the published pose: they grow along the chain (a random walk of
+  // the increments' errors) and restart at the first scan of a chain.
+  double chain_var_t_ = 0.0, chain_var_r_ = 0.0;
+  std::optional<std::pair<double, double>> start_var_;  // from ~set_pose, for the next first scan
 
   nav_msgs::Path path_;
   std::optional<std::uint32_t> last_seq_;
