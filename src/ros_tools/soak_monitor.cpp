@@ -98,8 +98,8 @@ struct Monitor {
       if (!right) {
         ++accepted_wrong;
         std::printf("soak: accepted but off: scan at %.3f s (loop %d), Es %.3f m, Ea %.2f deg, overlap %.3f, "
-                    "gate scale %.1f\n", s.header.stamp.toSec(), loops + 1, e.es_m, e.ea_deg, s.overlap,
-                    s.gate_scale);
+                    "gate scale %.1f, guess from %s\n", s.header.stamp.toSec(), loops + 1, e.es_m, e.ea_deg,
+                    s.overlap, s.gate_scale, s.odometry_guess ? "odometry" : "identity (no odometry)");
       }
       worst_accepted_es = std::max(worst_accepted_es, e.es_m);
       worst_accepted_ea = std::max(worst_accepted_ea, e.ea_deg);
