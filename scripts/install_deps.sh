@@ -16,7 +16,7 @@ PKGS=(
   libnav-msgs-dev libstd-srvs-dev libsensor-msgs-dev libgeometry-msgs-dev libdiagnostic-msgs-dev
   python3-rospy python3-nav-msgs python3-sensor-msgs python3-geometry-msgs python3-std-srvs
   python3-tf2-ros python3-diagnostic-msgs python3-numpy
-  rviz xvfb xauth imagemagick
+  rviz xvfb xauth imagemagick procps
   clang-14 libfuzzer-14-dev
 )
 missing=()

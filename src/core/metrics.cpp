@@ -1,5 +1,6 @@
 #include "cube_scan_matcher/core/metrics.h"
 
+#include <algorithm>
 #include <cmath>
 
 #include "cube_scan_matcher/core/pose.h"
@@ -15,6 +16,12 @@ PoseError poseError(const Eigen::Isometry3d& estimate, const Eigen::Isometry3d& 
     sum += d * d;
   }
   return {(a.head<3>() - b.head<3>()).norm(), rad2deg(std::sqrt(sum))};
+}
+
+double quantile(std::vector<double> values, double q) {
+  if (values.empty()) return 0.0;
+  std::sort(values.begin(), values.end());
+  return values[std::min(values.size() - 1, std::size_t(q * double(values.size())))];
 }
 
 }  // namespace cube_scan_matcher

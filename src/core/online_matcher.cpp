@@ -3,8 +3,8 @@
 #include <algorithm>
 #include <cmath>
 #include <sstream>
-#include <vector>
 #include <stdexcept>
+#include <vector>
 
 namespace cube_scan_matcher {
 

@@ -4,6 +4,7 @@
 #include <cmath>
 #include <iomanip>
 #include <sstream>
+#include <vector>
 
 #include <geometry_msgs/PoseWithCovarianceStamped.h>
 #include <geometry_msgs/TransformStamped.h>
@@ -13,6 +14,7 @@
 
 #include "cube_scan_matcher/Status.h"
 #include "cube_scan_matcher/core/filters.h"
+#include "cube_scan_matcher/core/metrics.h"
 #include "cube_scan_matcher/ros/cloud_conversion.h"
 #include "cube_scan_matcher/ros/transforms.h"
 
@@ -28,12 +30,6 @@ boost::array<double, 36> covariance(double sigma_m, double sigma_deg) {
   for (int i = 0; i < 3; ++i) c[std::size_t(i * 7)] = sigma_m * sigma_m;
   for (int i = 3; i < 6; ++i) c[std::size_t(i * 7)] = a * a;
   return c;
-}
-
-double percentile(std::deque<double> v, double q) {
-  if (v.empty()) return 0.0;
-  std::sort(v.begin(), v.end());
-  return v[std::min(v.size() - 1, std::size_t(q * double(v.size())))];
 }
 
 }  // namespace
@@ -385,11 +381,12 @@ void ScanMatcherNodelet::publishPose(const Scan& scan, const OnlineStep& step) {
   odometry.child_frame_id = params_.base_frame;
   odometry.pose = pose.pose;
   if (step.accepted && step.interval > 0.0) {
-    // Mean velocity over the increment, in base_frame at this scan: v = R^T t / dt, w = theta / dt.
-    const Eigen::Matrix3d Rt = step.increment.linear().transpose();
-    const Eigen::Vector3d v = Rt * step.increment.translation() / step.interval;
+    // Mean velocity over the increment, in base_frame at this scan: v = R^T t / dt, w = theta / dt
+    // (the rotation vector is the same in both frames: it lies on the rotation's axis).
+    const Eigen::Vector3d v =
+        step.increment.linear().transpose() * step.increment.translation() / step.interval;
     const Eigen::AngleAxisd aa(step.increment.linear());
-    const Eigen::Vector3d w = Rt * (aa.axis() * aa.angle()) / step.interval;
+    const Eigen::Vector3d w = aa.axis() * aa.angle() / step.interval;
     odometry.twist.twist.linear.x = v.x(), odometry.twist.twist.linear.y = v.y();
     odometry.twist.twist.linear.z = v.z();
     odometry.twist.twist.angular.x = w.x(), odometry.twist.twist.angular.y = w.y();
@@ -449,7 +446,8 @@ void ScanMatcherNodelet::diagnose(diagnostic_updater::DiagnosticStatusWrapper& s
     return;
   }
   std::lock_guard<std::mutex> lock(mutex_);
-  const double median = percentile(latencies_, 0.5), p95 = percentile(latencies_, 0.95);
+  const std::vector<double> latencies(latencies_.begin(), latencies_.end());
+  const double median = quantile(latencies, 0.5), p95 = quantile(latencies, 0.95);
   stat.add("scans processed", processed_);
   stat.add("scans rejected", rejected_);
   stat.add("consecutive rejections", consecutive_rejections_);

@@ -37,12 +37,6 @@ double residentMegabytes(int pid) {
   return -1.0;
 }
 
-double quantile(std::vector<double> v, double q) {
-  if (v.empty()) return 0.0;
-  std::sort(v.begin(), v.end());
-  return v[std::min(v.size() - 1, std::size_t(q * double(v.size())))];
-}
-
 /// A registration is right when its increment is within these of the truth (eqs. 7-8).
 constexpr double kRightM = 0.10, kRightDeg = 1.0;
 

@@ -112,18 +112,14 @@ std::string SweepEvaluator::summary() const {
   if (es.empty()) return "summary: no registered sweep";
   const SweepRow& last = *std::find_if(rows_.rbegin(), rows_.rend(),
                                        [](const SweepRow& r) { return r.reason != "dropped"; });
-  auto med = [](std::vector<double> v) {
-    std::sort(v.begin(), v.end());
-    return v[v.size() / 2];
-  };
   char buf[512];
   std::snprintf(buf, sizeof buf,
                 "summary over %zu increments: Es median %.3f m (max %.3f), Ea median %.3f deg "
                 "(max %.3f), success (Es < 0.10 m, Ea < 1 deg) %d/%zu, accepted %d/%zu, final "
                 "pose error %.3f m / %.3f deg, latency median %.3f s, %d dropped",
-                es.size(), med(es), *std::max_element(es.begin(), es.end()), med(ea),
+                es.size(), quantile(es, 0.5), *std::max_element(es.begin(), es.end()), quantile(ea, 0.5),
                 *std::max_element(ea.begin(), ea.end()), ok, es.size(), accepted, es.size(),
-                last.acc_es, last.acc_ea, med(lat), dropped);
+                last.acc_es, last.acc_ea, quantile(lat, 0.5), dropped);
   return buf;
 }
 

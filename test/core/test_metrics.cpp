@@ -24,3 +24,11 @@ TEST(Metrics, AnglesAreWrappedBeforeSquaring) {
   EXPECT_NEAR(poseError(poseToIsometry(a), poseToIsometry(b)).ea_deg, 2.0, 1e-9);
   EXPECT_NEAR(poseError(poseToIsometry(a), poseToIsometry(a)).ea_deg, 0.0, 1e-12);
 }
+
+TEST(Metrics, QuantileIsTheSortedElementAtFloorQn) {
+  EXPECT_EQ(quantile({}, 0.5), 0.0);
+  EXPECT_EQ(quantile({3.0, 1.0, 2.0}, 0.5), 2.0);
+  EXPECT_EQ(quantile({4.0, 1.0, 3.0, 2.0}, 0.5), 3.0);  // index 2 of 4, no averaging
+  EXPECT_EQ(quantile({5.0, 1.0, 4.0}, 1.0), 5.0);
+  EXPECT_EQ(quantile({5.0, 1.0, 4.0}, 0.0), 1.0);
+}

@@ -14,6 +14,7 @@
 #include <cstdio>
 #include <random>
 #include <thread>
+#include <utility>
 
 #include <diagnostic_msgs/DiagnosticArray.h>
 #include <dynamic_reconfigure/Reconfigure.h>
@@ -56,6 +57,26 @@ Eigen::Isometry3d mountB() {
   m.linear() = rotationFromRpy(0.0, deg2rad(6.0), deg2rad(3.0)) * sim::sensorToBodyRotation();
   m.translation() = Eigen::Vector3d(0.15, 0.05, 0.7);
   return m;
+}
+
+/// Calls the matcher's ~set_parameters with cube_edge [m], and threads and starts when > 0.
+/// Returns false if the call failed; `replied_edge` gets the cube_edge of the reply.
+bool setParameters(double cube_edge, int threads = 0, int starts = 0, double* replied_edge = nullptr) {
+  dynamic_reconfigure::Reconfigure r;
+  dynamic_reconfigure::DoubleParameter edge;
+  edge.name = "cube_edge", edge.value = cube_edge;
+  r.request.config.doubles = {edge};
+  for (const auto& [name, value] : {std::make_pair("threads", threads), std::make_pair("starts", starts)}) {
+    if (value <= 0) continue;
+    dynamic_reconfigure::IntParameter p;
+    p.name = name, p.value = value;
+    r.request.config.ints.push_back(p);
+  }
+  if (!ros::service::call(kNs + "set_parameters", r)) return false;
+  for (const auto& d : r.response.config.doubles) {
+    if (d.name == "cube_edge" && replied_edge) *replied_edge = d.value;
+  }
+  return true;
 }
 
 /// One drive, simulated once: truth, odometry and the sweep in the scanner frame per mount.
@@ -357,15 +378,9 @@ TEST_F(Faults, ResetAndReconfigureHammeredWhileScansAreProcessed) {
     while (!stop) {
       std_srvs::Trigger reset;
       (ros::service::call(kNs + "reset", reset) ? resets : failures)++;
-      dynamic_reconfigure::Reconfigure r;
-      dynamic_reconfigure::DoubleParameter edge;
-      edge.name = "cube_edge", edge.value = edges[rng() % 3];
-      dynamic_reconfigure::IntParameter threads, starts;
-      threads.name = "threads", threads.value = int(1 + rng() % 2);
-      starts.name = "starts", starts.value = int(1 + rng() % 4);
-      r.request.config.doubles = {edge};
-      r.request.config.ints = {threads, starts};
-      (ros::service::call(kNs + "set_parameters", r) ? reconfigures : failures)++;
+      const double edge = edges[rng() % 3];
+      const int threads = int(1 + rng() % 2), starts = int(1 + rng() % 4);
+      (setParameters(edge, threads, starts) ? reconfigures : failures)++;
       std::this_thread::sleep_for(std::chrono::milliseconds(20));
     }
   });
@@ -383,18 +398,9 @@ TEST_F(Faults, ResetAndReconfigureHammeredWhileScansAreProcessed) {
   std::printf("[faults] during 10 scans: %d resets, %d reconfigures\n", int(resets), int(reconfigures));
 
   // Back to the defaults: a new chain registers to the truth again.
-  dynamic_reconfigure::Reconfigure r;
-  dynamic_reconfigure::DoubleParameter edge;
-  edge.name = "cube_edge", edge.value = 0.5;
-  dynamic_reconfigure::IntParameter threads, starts;
-  threads.name = "threads", threads.value = 2;
-  starts.name = "starts", starts.value = 4;
-  r.request.config.doubles = {edge};
-  r.request.config.ints = {threads, starts};
-  ASSERT_TRUE(ros::service::call(kNs + "set_parameters", r));
-  bool edge_set = false;
-  for (const auto& d : r.response.config.doubles) edge_set |= d.name == "cube_edge" && d.value == 0.5;
-  EXPECT_TRUE(edge_set);
+  double replied = -1.0;
+  ASSERT_TRUE(setParameters(0.5, 2, 4, &replied));
+  EXPECT_EQ(replied, 0.5);
   std_srvs::Trigger reset;
   ASSERT_TRUE(ros::service::call(kNs + "reset", reset));
   t0 = freshStart();
@@ -433,15 +439,8 @@ TEST_F(Faults, LiveCubeEdgeWhoseGridsCannotBeBuiltIsRefused) {
   for (int k = 0; k < 2; ++k) {
     EXPECT_EQ(sendSweep(k, stampOf(k)).reason, k == 0 ? Status::FIRST_SCAN : Status::ACCEPTED);
   }
-  dynamic_reconfigure::Reconfigure r;
-  dynamic_reconfigure::DoubleParameter edge;
-  edge.name = "cube_edge", edge.value = 0.01;
-  r.request.config.doubles = {edge};
-  ASSERT_TRUE(ros::service::call(kNs + "set_parameters", r));
   double replied = -1.0;
-  for (const auto& d : r.response.config.doubles) {
-    if (d.name == "cube_edge") replied = d.value;
-  }
+  ASSERT_TRUE(setParameters(0.01, 0, 0, &replied));
   EXPECT_EQ(replied, 0.5);
   for (int k = 2; k < 4; ++k) {
     const Status s = sendSweep(k, stampOf(k));

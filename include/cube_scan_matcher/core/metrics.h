@@ -2,6 +2,8 @@
 // evaluator and the tests.
 #pragma once
 
+#include <vector>
+
 #include <Eigen/Geometry>
 
 namespace cube_scan_matcher {
@@ -13,5 +15,9 @@ struct PoseError {
                   ///< (each wrapped to (-180, 180]) [deg].
 };
 PoseError poseError(const Eigen::Isometry3d& estimate, const Eigen::Isometry3d& reference);
+
+/// The q-quantile (q in [0, 1]) of `values` as the element at index floor(q n) of the sorted
+/// values (the last one for q = 1); 0 for no value. Medians and p95s of the tools' reports.
+double quantile(std::vector<double> values, double q);
 
 }  // namespace cube_scan_matcher
