@@ -436,8 +436,10 @@ TEST_F(Faults, SensorExtrinsicChangeOnTfIsFollowed) {
 // refine grids far beyond max_grid_megabytes: the request is refused, the reply carries the
 // old value back, and registration goes on.
 TEST_F(Faults, LiveCubeEdgeWhoseGridsCannotBeBuiltIsRefused) {
+  Status before;
   for (int k = 0; k < 2; ++k) {
-    EXPECT_EQ(sendSweep(k, stampOf(k)).reason, k == 0 ? Status::FIRST_SCAN : Status::ACCEPTED);
+    before = sendSweep(k, stampOf(k));
+    EXPECT_EQ(before.reason, k == 0 ? Status::FIRST_SCAN : Status::ACCEPTED);
   }
   double replied = -1.0;
   ASSERT_TRUE(setParameters(0.01, 0, 0, &replied));
@@ -445,7 +447,9 @@ TEST_F(Faults, LiveCubeEdgeWhoseGridsCannotBeBuiltIsRefused) {
   for (int k = 2; k < 4; ++k) {
     const Status s = sendSweep(k, stampOf(k));
     EXPECT_EQ(s.reason, Status::ACCEPTED) << s.message;
-    EXPECT_LT(s.registration_time, 1.0);
+    // Still the 0.5 m grid (not a timing check: sanitizer builds are slow): at 0.05 m the
+    // reference would hold about 100 times the cubes.
+    EXPECT_LT(s.reference_cubes, 10 * before.reference_cubes);
     expectPose(k, stampOf(k));
   }
 }
