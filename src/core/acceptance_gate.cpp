@@ -38,7 +38,10 @@ Pose6 correctionFromGuess(const Pose6& guess, const Pose6& result) {
 GateReason gate(const RegistrationResult& r, const Pose6& guess, const GateSettings& s) {
   if (!r.ok()) return GateReason::RegistrationFailed;
   if (r.overlap() < s.min_overlap) return GateReason::LowOverlap;
-  if (r.J < r.J_guess + s.min_j_gain) return GateReason::NoGain;
+  // The gain of the search on the objective it maximised against the guess: the coarse stage's
+  // best J (eq. 5 on the E grid). J at the refined pose can be a few cubes below J at an exact
+  // guess (the refine optimises the finer grids), which is no sign of a bad result.
+  if (r.J_coarse < r.J_guess + s.min_j_gain) return GateReason::NoGain;
   const Eigen::Isometry3d c = poseToIsometry(guess).inverse() * r.transform;
   if (c.translation().norm() > s.max_correction_m ||
       Eigen::AngleAxisd(c.linear()).angle() > s.max_correction_rad) {

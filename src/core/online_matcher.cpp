@@ -6,6 +6,8 @@
 #include <stdexcept>
 #include <vector>
 
+#include "require_in_range.h"
+
 namespace cube_scan_matcher {
 
 void validate(const OnlineMatcherSettings& s) {
@@ -15,17 +17,24 @@ void validate(const OnlineMatcherSettings& s) {
     throw std::invalid_argument("max_consecutive_rejections must be >= 1, got " +
                                 std::to_string(s.max_consecutive_rejections));
   }
+  const KeyframeSettings& k = s.keyframes;
+  requireInRange("keyframe distance [m]", k.distance, 0.0, 1000.0);
+  requireInRange("keyframe angle [rad]", k.angle, 0.0, double(EIGEN_PI));
+  requireInRange("keyframe interval [s]", k.interval, 0.0, 1e6);
+  requireInRange("submap size [keyframes]", k.submap_size, 1, 20);
 }
 
 OnlineMatcher::OnlineMatcher(const OnlineMatcherSettings& settings)
-    : settings_(settings), registration_(settings.registration) {}
+    : settings_(settings), registration_(settings.registration) {
+  validate(settings);
+}
 
 void OnlineMatcher::reset() {
   registration_ = CubeRegistration(settings_.registration);
-  reference_points_ = PointArray{};
-  reference_pose_ = last_pose_ = Eigen::Isometry3d::Identity();
+  keyframes_.clear();
+  last_pose_ = Eigen::Isometry3d::Identity();
+  last_known_.reset();
   anchor_.reset();
-  reference_is_anchor_ = false;
   last_stamp_.reset();
   intervals_.clear();
   consecutive_rejections_ = 0;
@@ -37,26 +46,56 @@ void OnlineMatcher::restartAt(const Eigen::Isometry3d& pose) {
   start_pose_ = pose;
 }
 
+PointArray OnlineMatcher::submapPoints(const std::deque<Keyframe>& keyframes, int submap_size) {
+  const std::size_t n = std::min(keyframes.size(), std::size_t(submap_size));
+  if (n == 1) return keyframes.back().points;
+  PointArray merged;
+  const Eigen::Isometry3d to_newest = keyframes.back().pose.inverse();
+  for (std::size_t i = keyframes.size() - n; i < keyframes.size(); ++i) {
+    const Eigen::Matrix4f T = (to_newest * keyframes[i].pose).matrix().cast<float>();
+    const PointArray& p = keyframes[i].points;
+    for (std::size_t j = 0; j < p.size(); ++j) {
+      const Eigen::Vector3f q = T.topLeftCorner<3, 3>() * p.point(j) + T.topRightCorner<3, 1>();
+      merged.push_back(q.x(), q.y(), q.z());
+    }
+  }
+  return merged;
+}
+
+bool OnlineMatcher::addKeyframe(Keyframe keyframe, std::string& why) {
+  keyframes_.push_back(std::move(keyframe));
+  try {
+    registration_.setReference(submapPoints(keyframes_, settings_.keyframes.submap_size));
+  } catch (const std::exception& e) {
+    keyframes_.pop_back();
+    why = e.what();
+    return false;
+  }
+  while (keyframes_.size() > std::size_t(settings_.keyframes.submap_size)) keyframes_.pop_front();
+  return true;
+}
+
 void OnlineMatcher::setSettings(const OnlineMatcherSettings& settings) {
   validate(settings);
-  if (registration_.hasReference()) {
+  if (!keyframes_.empty()) {
     // Build the reference's grids with the new settings first: settings whose grids cannot be
     // built (the memory cap) throw here and leave the matcher as it was.
     CubeRegistration rebuilt(settings.registration);
     try {
-      rebuilt.setReference(reference_points_);
+      rebuilt.setReference(submapPoints(keyframes_, settings.keyframes.submap_size));
     } catch (const std::exception& e) {
       throw std::invalid_argument(std::string("the current reference cannot be built with these "
                                               "settings: ") + e.what());
     }
     registration_ = std::move(rebuilt);
+    while (keyframes_.size() > std::size_t(settings.keyframes.submap_size)) keyframes_.pop_front();
   } else {
     registration_.setSettings(settings.registration);
   }
   settings_ = settings;
 }
 
-double OnlineMatcher::gateScale(double stamp) const {
+double OnlineMatcher::gateScale(double stamp, double since) const {
   if (intervals_.empty()) return 1.0;
   // The scan period: the lower quartile of the recent intervals (the matcher sees longer ones
   // whenever scans are dropped; a few odd short ones do not move the quartile).
@@ -64,7 +103,7 @@ double OnlineMatcher::gateScale(double stamp) const {
   std::nth_element(v.begin(), v.begin() + std::ptrdiff_t(v.size() / 4), v.end());
   const double period = v[v.size() / 4];
   // Whole periods: timing jitter does not widen the bounds, a missed scan does.
-  return std::clamp(std::round((stamp - reference_stamp_) / period), 1.0, kMaxGateScale);
+  return std::clamp(std::round((stamp - since) / period), 1.0, kMaxGateScale);
 }
 
 OnlineStep OnlineMatcher::process(const PointArray& points, double stamp,
@@ -82,25 +121,31 @@ OnlineStep OnlineMatcher::process(const PointArray& points, double stamp,
     if (intervals_.size() > kIntervals) intervals_.pop_front();
   }
   last_stamp_ = stamp;
-  const bool first = !registration_.hasReference();
-  step.odometry_guess = odom && anchor_;
-  Eigen::Isometry3d odom_increment = Eigen::Isometry3d::Identity();
+  const bool first = keyframes_.empty();
+  // The predicted pose T_map_base: odometry from the anchor, else no motion since the last
+  // known pose.
+  step.odometry_guess = !first && odom && anchor_;
+  Eigen::Isometry3d predicted = start_pose_ ? *start_pose_ : odom ? *odom : Eigen::Isometry3d::Identity();
+  double predicted_from = stamp;
   if (step.odometry_guess) {
-    odom_increment = anchor_->odom.inverse() * *odom;
-    // Over references without odometry: predicted map pose, seen from the reference.
-    if (!reference_is_anchor_) odom_increment = reference_pose_.inverse() * anchor_->pose * odom_increment;
+    predicted = anchor_->pose * anchor_->odom->inverse() * *odom;
+    predicted_from = anchor_->stamp;
+  } else if (!first && last_known_) {
+    predicted = last_known_->pose;
+    predicted_from = last_known_->stamp;
   }
-  step.guess = isometryToPose(odom_increment);
-  step.increment = odom_increment;
+  const Keyframe* keyframe = first ? nullptr : &keyframes_.back();
+  if (keyframe) step.increment = keyframe->pose.inverse() * predicted;
+  step.guess = isometryToPose(step.increment);
 
   if (first) {
     step.reason = points.empty() ? GateReason::BadInput : GateReason::FirstScan;
-    step.pose = start_pose_ ? *start_pose_ : odom ? *odom : Eigen::Isometry3d::Identity();
+    step.pose = predicted;
   } else if (points.empty()) {
     step.reason = GateReason::BadInput;
   } else {
     step.registered = true;
-    step.gate_scale = gateScale(stamp);
+    step.gate_scale = gateScale(stamp, predicted_from);
     if (step.gate_scale > 1.0) {
       // The guess spans several increments: search as much wider as the gate is.
       RegistrationSettings wide = settings_.registration;
@@ -119,38 +164,48 @@ OnlineStep OnlineMatcher::process(const PointArray& points, double stamp,
     step.accepted = step.reason == GateReason::Accepted;
     if (step.accepted) step.increment = step.result.transform;
   }
-  if (!first) {
-    step.pose = reference_pose_ * step.increment;
-    step.interval = stamp - reference_stamp_;
-  }
+  if (keyframe) step.pose = keyframe->pose * step.increment;
 
   const bool rejected = !first && !step.accepted;
   consecutive_rejections_ = rejected ? consecutive_rejections_ + 1 : 0;
   step.consecutive_rejections = consecutive_rejections_;
   step.rejection_alarm = consecutive_rejections_ >= settings_.max_consecutive_rejections;
 
-  // This scan becomes the reference if it has points, its pose is known (or the chain has to
-  // move on) and its grid can be built.
-  const bool pose_unknown = rejected && !odom && !step.rejection_alarm;
-  if (pose_unknown && !points.empty()) {
-    if (!step.message.empty()) step.message += "; ";
-    step.message += "scan not used as reference: no odometry and the registration rejected";
-  } else if (!points.empty()) {
-    try {
-      registration_.setReference(points);
-      reference_points_ = points;
-      reference_pose_ = step.pose;
-      reference_stamp_ = stamp;
-      reference_is_anchor_ = odom.has_value();
-      if (odom) anchor_ = OdometryAnchor{step.pose, *odom};
-      step.reference_updated = true;
-      if (first) start_pose_.reset();
-    } catch (const std::exception& e) {
+  // A known pose (first, accepted, or forced on by the alarm) predicts the next scans.
+  const bool known = first || step.accepted || (step.rejection_alarm && !points.empty());
+  if (known && !points.empty()) {
+    if (last_known_ && stamp > last_known_->stamp) {
+      step.motion = last_known_->pose.inverse() * step.pose;
+      step.interval = stamp - last_known_->stamp;
+    }
+    // A new keyframe: the first scan, a forced one, or an accepted scan far enough from the
+    // keyframe (never a rejected one).
+    bool new_keyframe = first || !step.accepted;
+    if (!new_keyframe) {
+      const KeyframeSettings& k = settings_.keyframes;
+      const double moved = step.increment.translation().norm();
+      const double turned = Eigen::AngleAxisd(step.increment.linear()).angle();
+      new_keyframe = moved >= k.distance || turned >= k.angle ||
+                     (k.interval > 0.0 && stamp - keyframe->stamp >= k.interval);
+    }
+    std::string why;
+    if (new_keyframe && !addKeyframe(Keyframe{points, step.pose, stamp}, why)) {
       if (first) step.reason = GateReason::BadReference;
       if (!step.message.empty()) step.message += "; ";
-      step.message += std::string("scan not used as reference: ") + e.what();
+      step.message += "scan not used as reference: " + why;
+    } else {
+      step.reference_updated = new_keyframe;
     }
+    if (!first || step.reference_updated) {
+      last_known_ = Known{step.pose, odom, stamp};
+      if (odom) anchor_ = last_known_;
+      if (first) start_pose_.reset();
+    }
+  } else if (rejected && !points.empty()) {
+    if (!step.message.empty()) step.message += "; ";
+    step.message += "scan not used as reference: the registration was rejected";
   }
+  step.keyframes = int(std::min(keyframes_.size(), std::size_t(settings_.keyframes.submap_size)));
   last_pose_ = step.pose;
 
   std::ostringstream os;

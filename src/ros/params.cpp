@@ -48,6 +48,10 @@ void configToSettings(const ScanMatcherConfig& c, OnlineMatcherSettings& m) {
   m.gate.max_correction_m = c.max_correction_translation;
   m.gate.max_correction_rad = deg2rad(c.max_correction_rotation);
   m.max_consecutive_rejections = c.max_consecutive_rejections;
+  m.keyframes.distance = c.keyframe_distance;
+  m.keyframes.angle = deg2rad(c.keyframe_angle);
+  m.keyframes.interval = c.keyframe_interval;
+  m.keyframes.submap_size = c.submap_keyframes;
 }
 
 /// The unit in a cfg description ("Cube edge E [m] (paper ...)" -> "m"), or "".
@@ -114,6 +118,10 @@ ScanMatcherConfig toConfig(const NodeParams& p) {
   c.max_correction_translation = p.matcher.gate.max_correction_m;
   c.max_correction_rotation = rad2deg(p.matcher.gate.max_correction_rad);
   c.max_consecutive_rejections = p.matcher.max_consecutive_rejections;
+  c.keyframe_distance = p.matcher.keyframes.distance;
+  c.keyframe_angle = rad2deg(p.matcher.keyframes.angle);
+  c.keyframe_interval = p.matcher.keyframes.interval;
+  c.submap_keyframes = p.matcher.keyframes.submap_size;
   return c;
 }
 

@@ -339,6 +339,7 @@ OnlineStep ScanMatcherNodelet::registerScan(Scan& scan) {
   status.gate_scale = step.gate_scale;
   status.odometry_guess = step.odometry_guess;
   status.reference_updated = step.reference_updated;
+  status.keyframes = std::uint32_t(step.keyframes);
   status.time_reset = status.time_reset || step.time_reset;
   const bool rejected = step.reason != GateReason::Accepted && step.reason != GateReason::FirstScan;
   if (rejected) ++rejected_;
@@ -354,18 +355,22 @@ OnlineStep ScanMatcherNodelet::registerScan(Scan& scan) {
 }
 
 void ScanMatcherNodelet::publishPose(const Scan& scan, const OnlineStep& step) {
-  // Covariance along the chain: each accepted increment adds sigma^2, each one propagated by
-  // odometry (scale * sigma)^2; a chain starts at sigma^2 (or the ~set_pose covariance).
+  // Covariance along the chain of keyframes: a scan's pose is its keyframe's plus one
+  // increment, sigma^2 when accepted, (scale * sigma)^2 when propagated by odometry; a new
+  // keyframe keeps its variance. A chain starts at sigma^2 (or the ~set_pose covariance).
+  // Standing still (no new keyframe) the covariance does not grow.
   const double st = params_.sigma_translation, sr = deg2rad(params_.sigma_rotation);
+  double var_t, var_r;
   if (step.reason == GateReason::FirstScan) {
-    chain_var_t_ = start_var_ && start_var_->first > 0.0 ? start_var_->first : st * st;
-    chain_var_r_ = start_var_ && start_var_->second > 0.0 ? start_var_->second : sr * sr;
+    var_t = start_var_ && start_var_->first > 0.0 ? start_var_->first : st * st;
+    var_r = start_var_ && start_var_->second > 0.0 ? start_var_->second : sr * sr;
     start_var_.reset();
   } else {
     const double scale = step.accepted ? 1.0 : params_.rejected_sigma_scale;
-    chain_var_t_ += scale * scale * st * st;
-    chain_var_r_ += scale * scale * sr * sr;
+    var_t = keyframe_var_t_ + scale * scale * st * st;
+    var_r = keyframe_var_r_ + scale * scale * sr * sr;
   }
+  if (step.reference_updated) keyframe_var_t_ = var_t, keyframe_var_r_ = var_r;
   std_msgs::Header header;
   header.stamp = scan.msg.header.stamp;
   header.frame_id = params_.map_frame;
@@ -373,7 +378,7 @@ void ScanMatcherNodelet::publishPose(const Scan& scan, const OnlineStep& step) {
   geometry_msgs::PoseWithCovarianceStamped pose;
   pose.header = header;
   pose.pose.pose = toPoseMsg(step.pose);
-  pose.pose.covariance = covariance(std::sqrt(chain_var_t_), rad2deg(std::sqrt(chain_var_r_)));
+  pose.pose.covariance = covariance(std::sqrt(var_t), rad2deg(std::sqrt(var_r)));
   pose_pub_.publish(pose);
 
   nav_msgs::Odometry odometry;
@@ -381,11 +386,11 @@ void ScanMatcherNodelet::publishPose(const Scan& scan, const OnlineStep& step) {
   odometry.child_frame_id = params_.base_frame;
   odometry.pose = pose.pose;
   if (step.accepted && step.interval > 0.0) {
-    // Mean velocity over the increment, in base_frame at this scan: v = R^T t / dt, w = theta / dt
-    // (the rotation vector is the same in both frames: it lies on the rotation's axis).
+    // Mean velocity since the last registered scan, in base_frame at this scan: v = R^T t / dt,
+    // w = theta / dt (the rotation vector is the same in both frames: it lies on the axis).
     const Eigen::Vector3d v =
-        step.increment.linear().transpose() * step.increment.translation() / step.interval;
-    const Eigen::AngleAxisd aa(step.increment.linear());
+        step.motion.linear().transpose() * step.motion.translation() / step.interval;
+    const Eigen::AngleAxisd aa(step.motion.linear());
     const Eigen::Vector3d w = aa.axis() * aa.angle() / step.interval;
     odometry.twist.twist.linear.x = v.x(), odometry.twist.twist.linear.y = v.y();
     odometry.twist.twist.linear.z = v.z();

@@ -10,7 +10,7 @@ TEST(AcceptanceGate, RejectsLowOverlapNoGainAndLargeCorrections) {
   RegistrationResult r;
   r.status = RegistrationStatus::Ok;
   r.reference_cubes = 1000;
-  r.J = 500;
+  r.J = r.J_coarse = 500;
   r.J_guess = 400;
   r.pose << 0.2, 0, 0, 0, 0, 0;
   r.transform = poseToIsometry(r.pose);
@@ -30,4 +30,21 @@ TEST(AcceptanceGate, RejectsLowOverlapNoGainAndLargeCorrections) {
   g = GateSettings{};
   g.min_overlap = 1.5;
   EXPECT_THROW(validate(g), std::invalid_argument);
+}
+
+// An exact guess: the refined pose can score a few E-grid cubes below it (the refine maximises
+// the finer grids). The gain is judged on the coarse stage's best J, not on J at the result.
+TEST(AcceptanceGate, NoGainIsJudgedOnTheCoarseStage) {
+  RegistrationResult r;
+  r.status = RegistrationStatus::Ok;
+  r.reference_cubes = 1000;
+  r.J_guess = 600;
+  r.J_coarse = 601;
+  r.J = 599;
+  const Pose6 guess = Pose6::Zero();
+  r.pose = guess;
+  r.transform = poseToIsometry(r.pose);
+  EXPECT_EQ(gate(r, guess, GateSettings{}), GateReason::Accepted);
+  r.J_coarse = 599;
+  EXPECT_EQ(gate(r, guess, GateSettings{}), GateReason::NoGain);
 }

@@ -53,7 +53,9 @@ TEST(OnlineMatcher, TimeBackwardsResetsAndEmptyOrBadScansKeepTheReference) {
   body.translation() = Eigen::Vector3d(2, 0.5, 1.0);
   body.linear() = rotationFromRpy(0, 0, deg2rad(17));
   const PointArray scan = scanInBase(scene, body, rng);
-  OnlineMatcher m{OnlineMatcherSettings{}};
+  OnlineMatcherSettings every_scan;
+  every_scan.keyframes.distance = 0.0;  // every accepted scan would become the keyframe
+  OnlineMatcher m(every_scan);
   EXPECT_EQ(m.process(scan, 5.0, std::nullopt).reason, GateReason::FirstScan);
 
   OnlineStep s = m.process(PointArray{}, 6.0, std::nullopt);
@@ -64,6 +66,7 @@ TEST(OnlineMatcher, TimeBackwardsResetsAndEmptyOrBadScansKeepTheReference) {
   PointArray absurd = scan;
   absurd.push_back(1e7f, 1e7f, 1e7f);  // the grid would exceed the memory cap
   s = m.process(absurd, 7.0, std::nullopt);
+  EXPECT_EQ(s.reason, GateReason::Accepted) << s.message;
   EXPECT_FALSE(s.reference_updated);
   EXPECT_NE(s.message.find("not used as reference"), std::string::npos) << s.message;
   EXPECT_TRUE(m.hasReference());
@@ -153,8 +156,9 @@ TEST(OnlineMatcher, OdometryGapIsBridgedFromTheLastScanWithOdometry) {
   EXPECT_TRUE(s.reference_updated);
 }
 
-// Dropped scans make the guess span several increments, and the odometry error with them: the
-// correction bounds grow with the time since the reference, in scan periods.
+// Dropped or rejected scans make the prediction span several increments, and the odometry
+// error with them: the correction bounds grow with the time since the last known pose, in
+// scan periods.
 TEST(OnlineMatcher, CorrectionBoundsGrowWithTheScansTheGuessSpans) {
   const sim::Scene scene = sim::Scene::generate(sim::SceneType::Park, 2);
   std::mt19937_64 rng(3);
@@ -173,11 +177,11 @@ TEST(OnlineMatcher, CorrectionBoundsGrowWithTheScansTheGuessSpans) {
   OnlineStep s = m.process(scan, 4.0, odom);
   EXPECT_EQ(s.reason, GateReason::CorrectionTooLarge) << s.message;
   EXPECT_DOUBLE_EQ(s.gate_scale, 1.0);
-  odom.translation().x() = 0.0;  // 0.1 m back, over three periods (two scans dropped)
-  s = m.process(scan, 7.0, odom);
-  EXPECT_DOUBLE_EQ(s.gate_scale, 3.0);
+  odom.translation().x() = 0.1;  // the same 0.1 m, predicted from the last known scan (at 3 s)
+  s = m.process(scan, 7.0, odom);  // over four periods: the rejected one and two dropped
+  EXPECT_DOUBLE_EQ(s.gate_scale, 4.0);
   EXPECT_EQ(s.reason, GateReason::Accepted) << s.message;
-  EXPECT_NE(s.message.find("bounds x3"), std::string::npos) << s.message;
+  EXPECT_NE(s.message.find("bounds x4"), std::string::npos) << s.message;
 }
 
 // Settings whose grids cannot be built for the current reference are refused at once, and the
@@ -203,4 +207,70 @@ TEST(OnlineMatcher, SettingsWhoseGridsCannotBeBuiltAreRefusedAndTheOldOnesStay) 
   finer.registration.grid.cube_edge = 0.3;
   EXPECT_NO_THROW(m.setSettings(finer));
   EXPECT_EQ(m.process(scan, 3.0, std::nullopt).reason, GateReason::Accepted);
+}
+
+// Standing still: every scan is registered to the same keyframe, so the pose error does not
+// grow with the scans (scan-to-scan chaining adds each scan's error to the next).
+TEST(OnlineMatcher, StandingStillAddsNoDriftWithKeyframes) {
+  const sim::Scene scene = sim::Scene::generate(sim::SceneType::Urban, 3);
+  std::mt19937_64 rng(11);
+  Eigen::Isometry3d body = Eigen::Isometry3d::Identity();
+  body.translation() = Eigen::Vector3d(5, 0.3, scene.groundHeight(5, 0.3) + 1.0);
+  OnlineMatcher m{OnlineMatcherSettings{}};
+  const Eigen::Isometry3d odom = body;  // exact odometry: any error is the registration's
+  Eigen::Isometry3d first_pose;
+  for (int k = 0; k < 12; ++k) {
+    const OnlineStep s = m.process(scanInBase(scene, body, rng), double(k), odom);  // new noise
+    if (k == 0) first_pose = s.pose;
+    EXPECT_EQ(s.reason, k == 0 ? GateReason::FirstScan : GateReason::Accepted) << s.message;
+    EXPECT_EQ(s.reference_updated, k == 0) << "scan " << k;
+    EXPECT_EQ(s.keyframes, 1);
+    // One registration's error (issue 12's scatter), not a sum over the scans.
+    EXPECT_LT(translationError(s.pose, first_pose), 0.05) << "scan " << k;
+  }
+}
+
+// Keyframes follow the motion thresholds; a submap merges the last K of them into the
+// reference, and the chain stays on the truth.
+TEST(OnlineMatcher, KeyframesFollowTheThresholdsAndTheSubmapMergesTheLastOnes) {
+  const sim::Scene scene = sim::Scene::generate(sim::SceneType::Park, 5);
+  sim::MotionSettings motion;
+  motion.step_min = 0.6, motion.step_max = 0.8, motion.yaw_change_max_deg = 3.0;
+  sim::RobotMotion robot(scene, motion, 6);
+  sim::OdometrySimulator odometry(sim::OdometryError::Small, 7);
+  std::mt19937_64 rng(8);
+  OnlineMatcherSettings settings;
+  settings.keyframes.distance = 1.0;  // every second scan or so
+  settings.keyframes.angle = 1.0;
+  settings.keyframes.submap_size = 3;
+  OnlineMatcher m(settings);
+  Eigen::Isometry3d keyframe_truth;
+  int keyframes = 0;
+  for (int k = 0; k < 8; ++k) {
+    if (k > 0) robot.advance();
+    const OnlineStep s = m.process(scanInBase(scene, robot.pose(), rng), double(k),
+                                   odometry.next(robot.pose()));
+    EXPECT_EQ(s.reason, k == 0 ? GateReason::FirstScan : GateReason::Accepted) << s.message;
+    if (k > 0) {
+      // A new keyframe exactly when the scan moved >= 1 m from the last (by the estimate).
+      const double moved = (keyframe_truth.inverse() * robot.pose()).translation().norm();
+      if (std::abs(moved - 1.0) > 0.1) {
+        EXPECT_EQ(s.reference_updated, moved >= 1.0) << "scan " << k;
+      }
+    }
+    if (s.reference_updated) keyframe_truth = robot.pose(), ++keyframes;
+    EXPECT_EQ(s.keyframes, std::min(keyframes, 3));
+    EXPECT_LT(translationError(s.pose, robot.pose()), 0.05) << "scan " << k;
+  }
+  EXPECT_GE(keyframes, 4);
+  EXPECT_LE(keyframes, 6);
+  OnlineMatcherSettings bad = settings;
+  bad.keyframes.submap_size = 0;
+  EXPECT_THROW(m.setSettings(bad), std::invalid_argument);
+  bad.keyframes.submap_size = 1;  // shrinking the submap rebuilds the reference from the last
+  m.setSettings(bad);
+  robot.advance();
+  const OnlineStep s = m.process(scanInBase(scene, robot.pose(), rng), 8.0, odometry.next(robot.pose()));
+  EXPECT_EQ(s.reason, GateReason::Accepted) << s.message;
+  EXPECT_EQ(s.keyframes, 1);
 }

@@ -1,7 +1,9 @@
-// Online scan-to-previous-scan registration with a pose chain: the ROS-free heart of the
-// nodelet. Each scan (in the robot's base frame) is registered to the current reference scan
-// around the odometry increment, gated, chained onto the reference's pose, and becomes the
-// next reference.
+// Online scan-to-keyframe registration with a pose chain: the ROS-free heart of the nodelet
+// and of the sequence benchmark. Each scan (in the robot's base frame) is registered to the
+// reference (the current keyframe, or a submap of the last keyframes merged into one cube grid
+// in the keyframe's frame; the paper's "match multiple scans", section 5) around the odometry
+// prediction, gated, and chained onto the keyframe's pose. An accepted scan that moved far
+// enough from the keyframe becomes the next keyframe.
 #pragma once
 
 #include <deque>
@@ -15,9 +17,22 @@
 
 namespace cube_scan_matcher {
 
+/// When an accepted scan becomes the next keyframe: when it moved at least `distance` [m] or
+/// `angle` [rad] from the current one, or `interval` [s] passed (0 = never by time). Zero
+/// distance: every accepted scan is a keyframe (scan-to-scan chaining). A scan that did not
+/// move far enough is registered to the same keyframe, so standing still adds no drift.
+struct KeyframeSettings {
+  double distance = 0.5;
+  double angle = 5.0 * EIGEN_PI / 180.0;
+  double interval = 0.0;
+  /// Keyframes merged into the reference (1 = the last keyframe only), in [1, 20].
+  int submap_size = 1;
+};
+
 struct OnlineMatcherSettings {
   RegistrationSettings registration;
   GateSettings gate;
+  KeyframeSettings keyframes;
   /// After this many consecutive rejected scans the step reports `rejection_alarm`. >= 1.
   int max_consecutive_rejections = 5;
 };
@@ -31,7 +46,7 @@ struct OnlineStep {
   bool registered = false;         ///< align() ran (a reference existed and the scan had points).
   bool accepted = false;           ///< the registration result gave the increment.
   bool odometry_guess = false;     ///< the guess came from odometry at both stamps (else identity).
-  bool reference_updated = false;  ///< this scan is now the reference.
+  bool reference_updated = false;  ///< this scan is now the keyframe (the reference rebuilt).
   bool time_reset = false;         ///< time went backwards: state was reset before this scan.
   bool rejection_alarm = false;    ///< consecutive rejections >= max_consecutive_rejections.
   int consecutive_rejections = 0;
@@ -44,8 +59,12 @@ struct OnlineStep {
   RegistrationResult result;       ///< valid when registered.
   Pose6 guess = Pose6::Zero();     ///< scan -> reference guess [m, rad].
   Pose6 correction = Pose6::Zero();  ///< guess^-1 * result [m, rad] (zero if not registered).
-  Eigen::Isometry3d increment = Eigen::Isometry3d::Identity();  ///< scan -> reference, used.
-  double interval = 0.0;           ///< [s] from the reference's stamp to this scan's (0 if first).
+  Eigen::Isometry3d increment = Eigen::Isometry3d::Identity();  ///< scan -> keyframe, used.
+  /// This scan's pose seen from the last scan whose pose was known (the first, an accepted or
+  /// a forced one) and the time between them [s] (0 if first): the motion behind the twist.
+  Eigen::Isometry3d motion = Eigen::Isometry3d::Identity();
+  double interval = 0.0;
+  int keyframes = 0;               ///< keyframes in the reference after this scan.
   Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();       ///< T_map_base of this scan.
   std::string message;             ///< why, for logs.
 };
@@ -57,11 +76,11 @@ class OnlineMatcher {
   /// `points`: the scan in the base frame at `stamp` [s] (finite points). `odom`: T_odom_base
   /// at `stamp` when known. The first scan's pose is its odometry pose (map = odom there), or
   /// identity without odometry. The guess is the odometry increment from the last reference
-  /// that had odometry, carried over the accepted increments since (identity without
-  /// odometry). A scan whose pose is unknown (no odometry and its registration rejected) does
-  /// not become the reference, unless max_consecutive_rejections scans in a row were rejected.
-  /// The gate's correction bounds and the search's restart bounds grow with the time since the
-  /// reference, in whole scan periods: see OnlineStep::gate_scale.
+  /// whose pose is known, carried over the accepted poses since (without odometry: the last
+  /// known pose, i.e. no motion). A rejected scan never becomes a keyframe, unless
+  /// max_consecutive_rejections scans in a row were rejected (the chain then moves on from the
+  /// prediction). The gate's correction bounds and the search's restart bounds grow with the
+  /// time the prediction spans, in whole scan periods: see OnlineStep::gate_scale.
   OnlineStep process(const PointArray& points, double stamp,
                      const std::optional<Eigen::Isometry3d>& odom);
 
@@ -82,21 +101,32 @@ class OnlineMatcher {
   const Eigen::Isometry3d& lastPose() const { return last_pose_; }
 
  private:
-  double gateScale(double stamp) const;
+  struct Keyframe {
+    PointArray points;        // base frame
+    Eigen::Isometry3d pose;   // T_map_base
+    double stamp;             // [s]
+  };
+  /// The reference's points: the last submap_size keyframes in the frame of the newest.
+  static PointArray submapPoints(const std::deque<Keyframe>& keyframes, int submap_size);
+  /// Adds a keyframe and rebuilds the reference; false (state unchanged) if its grid cannot
+  /// be built, with the reason in `why`.
+  bool addKeyframe(Keyframe keyframe, std::string& why);
+  double gateScale(double stamp, double since) const;
   OnlineMatcherSettings settings_;
   CubeRegistration registration_;
-  PointArray reference_points_;  // kept to rebuild the grid when the cube edge changes
-  Eigen::Isometry3d reference_pose_ = Eigen::Isometry3d::Identity();  // T_map_base(reference)
+  std::deque<Keyframe> keyframes_;  // oldest first; back() is the reference's frame
   std::optional<Eigen::Isometry3d> start_pose_;  // of the next first scan (restartAt)
-  /// The last reference scan that had odometry: T_map_base and T_odom_base there. A scan with
-  /// odometry is guessed from it, also when the references since then had none (a tf gap).
-  struct OdometryAnchor {
-    Eigen::Isometry3d pose, odom;
+  /// A scan whose pose is known: T_map_base, T_odom_base there (if it had odometry), stamp.
+  struct Known {
+    Eigen::Isometry3d pose;
+    std::optional<Eigen::Isometry3d> odom;
+    double stamp;
   };
-  std::optional<OdometryAnchor> anchor_;
-  bool reference_is_anchor_ = false;
+  std::optional<Known> last_known_;  // the prediction without odometry starts here
+  /// The last known scan that had odometry: a scan with odometry is predicted from it, also
+  /// when the scans since then had none (a tf gap).
+  std::optional<Known> anchor_;
   std::optional<double> last_stamp_;
-  double reference_stamp_ = 0.0;
   std::deque<double> intervals_;  // [s] between consecutive scans, the last kIntervals
   static constexpr std::size_t kIntervals = 16;
   static constexpr double kMaxGateScale = 4.0;

@@ -94,7 +94,7 @@ class ScanMatcherNodelet : public nodelet::Nodelet {
 
   // Variances [m^2], [rad^2] of the published pose: they grow along the chain (a random walk of
   // the increments' errors) and restart at the first scan of a chain.
-  double chain_var_t_ = 0.0, chain_var_r_ = 0.0;
+  double keyframe_var_t_ = 0.0, keyframe_var_r_ = 0.0;  // [m^2], [rad^2] of the keyframe pose
   std::optional<std::pair<double, double>> start_var_;  // from ~set_pose, for the next first scan
 
   nav_msgs::Path path_;
