@@ -5,10 +5,13 @@
 #   bash scripts/rviz_check.sh [OUTPUT.png] [SCENE]      (needs a built package)
 set -eo pipefail
 ROOT="$(cd "$(dirname "$0")/.." && pwd)"
-BUILD="${CSM_BUILD_DIR:-$ROOT/build}"   # the build directory (CTest passes its own)
-OUT="${1:-$BUILD/rviz_check.png}"; SCENE="${2:-urban}"
+# The devel space's setup: CTest passes its own (build/devel in a plain build, the workspace's
+# devel/ under catkin_make), else this checkout's build/devel.
+SETUP="${CSM_SETUP:-$ROOT/build/devel/setup.bash}"
+OUT="${1:-$ROOT/build/rviz_check.png}"; SCENE="${2:-urban}"
 export PATH=/usr/sbin:/usr/bin:/sbin:/bin:$PATH
-source "$BUILD/devel/setup.bash"
+[ -f "$SETUP" ] || { echo "rviz_check: $SETUP not found (build the package first)"; exit 1; }
+source "$SETUP"
 export ROS_MASTER_URI=http://localhost:$((11900 + RANDOM % 500))
 LOG="$(mktemp)"
 xvfb-run -a -s "-screen 0 1280x800x24" bash -c "

@@ -4,7 +4,9 @@
 # the real-data accuracy check: the cube method with the default settings must succeed
 # (Es < 0.10 m and Ea < 1 deg) in at least 24 of 25 trials from +-1 m / +-8 deg on every pair,
 # and every folder, written into a bag with clouds_to_bag (odometry off by +-0.5 m / +-5 deg),
-# must replay through launch/bag_replay.launch with every registration accepted.
+# must replay through launch/bag_replay.launch with every registration accepted; a folder that
+# is a sequence (poses.tum) is chained by sequence_benchmark from odometry with the "big"
+# errors: every scan accepted, drift <= 1 % and <= 0.05 deg/m over its longest segments.
 #   usage: scripts/test.sh [DATA_DIR]
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -22,6 +24,11 @@ if [ -n "$DATA_DIR" ]; then
     build/devel/lib/cube_scan_matcher/benchmark "$d" --methods cubes --trials 25 \
       --require-success 24 --csv "build/accuracy_$(basename "$d").csv" 2>/dev/null || status=1
     bash scripts/replay_check.sh "$d" || status=1
+    if [ -f "$d/poses.tum" ]; then
+      build/devel/lib/cube_scan_matcher/sequence_benchmark --dir "$d" --methods cubes \
+        --odometry big --csv "build/sequence_$(basename "$d").csv" --check-pct 1.0 \
+        --check-deg-m 0.05 --check-rejected 0 2>&1 | grep -v "^scan " || status=1
+    fi
   done
 else
   echo "== real-data accuracy check NOT run: no DATA_DIR given (CI passes ../shared/data)"

@@ -22,6 +22,7 @@ void validate(const OnlineMatcherSettings& s) {
   requireInRange("keyframe angle [rad]", k.angle, 0.0, double(EIGEN_PI));
   requireInRange("keyframe interval [s]", k.interval, 0.0, 1e6);
   requireInRange("submap size [keyframes]", k.submap_size, 1, 20);
+  requireInRange("no_odometry_scale", s.no_odometry_scale, 1.0, 10.0);
 }
 
 OnlineMatcher::OnlineMatcher(const OnlineMatcherSettings& settings)
@@ -34,6 +35,7 @@ void OnlineMatcher::reset() {
   keyframes_.clear();
   last_pose_ = Eigen::Isometry3d::Identity();
   last_known_.reset();
+  velocity_ = Pose6::Zero();
   anchor_.reset();
   last_stamp_.reset();
   intervals_.clear();
@@ -132,6 +134,9 @@ OnlineStep OnlineMatcher::process(const PointArray& points, double stamp,
     predicted_from = anchor_->stamp;
   } else if (!first && last_known_) {
     predicted = last_known_->pose;
+    if (settings_.constant_velocity) {
+      predicted = predicted * poseToIsometry(velocity_ * (stamp - last_known_->stamp));
+    }
     predicted_from = last_known_->stamp;
   }
   const Keyframe* keyframe = first ? nullptr : &keyframes_.back();
@@ -146,16 +151,26 @@ OnlineStep OnlineMatcher::process(const PointArray& points, double stamp,
   } else {
     step.registered = true;
     step.gate_scale = gateScale(stamp, predicted_from);
-    if (step.gate_scale > 1.0) {
-      // The guess spans several increments: search as much wider as the gate is.
-      RegistrationSettings wide = settings_.registration;
-      wide.gnmm.bounds *= step.gate_scale;
-      registration_.setSettings(wide);
-      step.result = registration_.align(points, step.guess);
-      registration_.setSettings(settings_.registration);
-    } else {
-      step.result = registration_.align(points, step.guess);
+    if (!step.odometry_guess) step.gate_scale = std::max(step.gate_scale, settings_.no_odometry_scale);
+    // The guess spans several increments, or has no odometry: search as much wider as the
+    // gate is.
+    RegistrationSettings wide = settings_.registration;
+    wide.gnmm.bounds *= step.gate_scale;
+    if (step.gate_scale > 1.0) registration_.setSettings(wide);
+    step.result = registration_.align(points, step.guess);
+    if (!step.odometry_guess && settings_.constant_velocity && last_known_) {
+      // Constant velocity fails where the motion changes most (a turn on the spot that starts,
+      // stops or reverses): the no-motion guess is searched too, and the higher J wins.
+      const Pose6 still = isometryToPose(keyframe->pose.inverse() * last_known_->pose);
+      if ((still - step.guess).norm() > 1e-6) {
+        RegistrationResult other = registration_.align(points, still);
+        if (other.ok() && (!step.result.ok() || other.J > step.result.J)) {
+          step.result = std::move(other);
+          step.guess = still;
+        }
+      }
     }
+    if (step.gate_scale > 1.0) registration_.setSettings(settings_.registration);
     GateSettings gate_settings = settings_.gate;
     gate_settings.max_correction_m *= step.gate_scale;
     gate_settings.max_correction_rad *= step.gate_scale;
@@ -177,6 +192,7 @@ OnlineStep OnlineMatcher::process(const PointArray& points, double stamp,
     if (last_known_ && stamp > last_known_->stamp) {
       step.motion = last_known_->pose.inverse() * step.pose;
       step.interval = stamp - last_known_->stamp;
+      velocity_ = isometryToPose(step.motion) / step.interval;
     }
     // A new keyframe: the first scan, a forced one, or an accepted scan far enough from the
     // keyframe (never a rejected one).
@@ -211,7 +227,10 @@ OnlineStep OnlineMatcher::process(const PointArray& points, double stamp,
   std::ostringstream os;
   os << toString(step.reason);
   if (step.registered) os << " (" << step.result.message << ")";
-  if (step.gate_scale > 1.0) os << "; correction bounds x" << step.gate_scale << " (scans missed)";
+  if (step.gate_scale > 1.0) {
+    os << "; correction bounds x" << step.gate_scale
+       << (step.odometry_guess ? " (scans missed)" : " (no odometry)");
+  }
   if (!step.message.empty()) os << "; " << step.message;
   step.message = os.str();
   return step;

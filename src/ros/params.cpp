@@ -52,6 +52,7 @@ void configToSettings(const ScanMatcherConfig& c, OnlineMatcherSettings& m) {
   m.keyframes.angle = deg2rad(c.keyframe_angle);
   m.keyframes.interval = c.keyframe_interval;
   m.keyframes.submap_size = c.submap_keyframes;
+  m.constant_velocity = c.constant_velocity;
 }
 
 /// The unit in a cfg description ("Cube edge E [m] (paper ...)" -> "m"), or "".
@@ -122,6 +123,7 @@ ScanMatcherConfig toConfig(const NodeParams& p) {
   c.keyframe_angle = rad2deg(p.matcher.keyframes.angle);
   c.keyframe_interval = p.matcher.keyframes.interval;
   c.submap_keyframes = p.matcher.keyframes.submap_size;
+  c.constant_velocity = p.matcher.constant_velocity;
   return c;
 }
 

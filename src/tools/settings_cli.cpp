@@ -1,6 +1,7 @@
 #include "settings_cli.h"
 
 #include <cstdlib>
+#include <sstream>
 #include <stdexcept>
 
 
@@ -119,6 +120,15 @@ bool parseAlgorithmOption(const std::vector<std::string>& args, std::size_t& i,
   }
   i += used;
   return true;
+}
+
+std::vector<std::string> splitList(const std::string& s) {
+  std::vector<std::string> out;
+  std::stringstream ss(s);
+  for (std::string item; std::getline(ss, item, ',');) {
+    if (!item.empty()) out.push_back(item);
+  }
+  return out;
 }
 
 }  // namespace cube_scan_matcher::tools

@@ -18,4 +18,7 @@ std::string algorithmOptionsHelp();
 bool parseAlgorithmOption(const std::vector<std::string>& args, std::size_t& i,
                           RegistrationSettings& settings, RangeFilterSettings& filter);
 
+/// "a,b,,c" -> {"a", "b", "c"} (empty items dropped).
+std::vector<std::string> splitList(const std::string& s);
+
 }  // namespace cube_scan_matcher::tools

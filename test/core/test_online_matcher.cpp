@@ -13,14 +13,7 @@ namespace {
 
 /// A scan of `scene` from base pose `body`, in base_link.
 PointArray scanInBase(const sim::Scene& scene, const Eigen::Isometry3d& body, std::mt19937_64& rng) {
-  Eigen::Isometry3d mount = Eigen::Isometry3d::Identity();
-  mount.linear() = sim::sensorToBodyRotation();
-  PointArray p = sim::scan(scene, sim::ScannerModel{}, body * mount, rng);
-  for (std::size_t i = 0; i < p.size(); ++i) {
-    const Eigen::Vector3f q = mount.cast<float>() * p.point(i);
-    p.x[i] = q.x(), p.y[i] = q.y(), p.z[i] = q.z();
-  }
-  return p;
+  return sim::scanInBody(scene, sim::ScannerModel{}, body, rng);
 }
 
 double translationError(const Eigen::Isometry3d& a, const Eigen::Isometry3d& b) {

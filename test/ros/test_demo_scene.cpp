@@ -2,8 +2,8 @@
 // SweepEvaluator, with the paper's "big" odometry errors (+-1 m, +-8 deg per increment).
 // Every increment must be within 5 cm / 0.5 deg of the truth, every sweep accepted, and
 // status and registered_cloud published for each sweep. While the demo runs, map -> base_link
-// must be available at the current time within 0.1 s (map -> odom post-dated, as a navigation
-// stack needs).
+// must be available at the current time within 0.3 s, a costmap's default transform_tolerance
+// (map -> odom post-dated, as a navigation stack needs).
 #include <gtest/gtest.h>
 
 #include <cstdio>
@@ -28,11 +28,11 @@ TEST(DemoScene, EveryIncrementMatchesTheTruth) {
   while (ros::ok() && int(evaluator.rows().size()) < sweeps && ros::WallTime::now() < end) {
     ros::spinOnce();
     if (!evaluator.rows().empty() && ros::WallTime::now() >= next_lookup) {
-      // As a costmap would: map -> base_link at the current time, waiting at most 0.1 s (the
-      // odometry comes at 50 Hz, so its latest is up to 20 ms old).
+      // As a costmap would: map -> base_link at the current time, waiting at most 0.3 s (the
+      // odometry comes at 50 Hz, so its latest is 20 ms old, more on a loaded machine).
       ++lookups;
       std::string error;
-      if (tf_buffer.canTransform("map", "base_link", ros::Time::now(), ros::Duration(0.1), &error)) {
+      if (tf_buffer.canTransform("map", "base_link", ros::Time::now(), ros::Duration(0.3), &error)) {
         ++lookups_ok;
       } else {
         lookup_error = error;

@@ -26,13 +26,20 @@ struct KeyframeSettings {
   double angle = 5.0 * EIGEN_PI / 180.0;
   double interval = 0.0;
   /// Keyframes merged into the reference (1 = the last keyframe only), in [1, 20].
-  int submap_size = 1;
+  int submap_size = 3;
 };
 
 struct OnlineMatcherSettings {
   RegistrationSettings registration;
   GateSettings gate;
   KeyframeSettings keyframes;
+  /// Without odometry, predict a scan from the last registered motion per second (constant
+  /// velocity) instead of from no motion.
+  bool constant_velocity = true;
+  /// Without odometry the prediction is uncertain (the robot may start, stop or turn on the
+  /// spot): the search's restart bounds and the gate's correction bounds are multiplied by
+  /// this (as by OnlineStep::gate_scale, the larger of the two). In [1, 10].
+  double no_odometry_scale = 4.0;
   /// After this many consecutive rejected scans the step reports `rejection_alarm`. >= 1.
   int max_consecutive_rejections = 5;
 };
@@ -77,7 +84,8 @@ class OnlineMatcher {
   /// at `stamp` when known. The first scan's pose is its odometry pose (map = odom there), or
   /// identity without odometry. The guess is the odometry increment from the last reference
   /// whose pose is known, carried over the accepted poses since (without odometry: the last
-  /// known pose, i.e. no motion). A rejected scan never becomes a keyframe, unless
+  /// known pose moved on at the last registered velocity, or not moved if constant_velocity
+  /// is off). A rejected scan never becomes a keyframe, unless
   /// max_consecutive_rejections scans in a row were rejected (the chain then moves on from the
   /// prediction). The gate's correction bounds and the search's restart bounds grow with the
   /// time the prediction spans, in whole scan periods: see OnlineStep::gate_scale.
@@ -123,6 +131,7 @@ class OnlineMatcher {
     double stamp;
   };
   std::optional<Known> last_known_;  // the prediction without odometry starts here
+  Pose6 velocity_ = Pose6::Zero();   // [m/s, rad/s] the last registered motion per second
   /// The last known scan that had odometry: a scan with odometry is predicted from it, also
   /// when the scans since then had none (a tf gap).
   std::optional<Known> anchor_;

@@ -31,4 +31,23 @@ std::vector<PairEntry> readPairs(const std::string& dir);
 std::vector<PairEntry> parsePairs(std::istream& in, const std::string& file,
                                   const std::string& dir);
 
+/// One line of a TUM trajectory: "stamp tx ty tz qx qy qz qw" (seconds, metres, Hamilton).
+struct StampedPose {
+  double stamp = 0.0;
+  Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();
+};
+/// Reads a TUM trajectory file ('#' comments and blank lines skipped). Throws
+/// std::runtime_error naming the file and line on a bad line, a non-unit quaternion or stamps
+/// that do not increase.
+std::vector<StampedPose> readTum(const std::string& file);
+std::vector<StampedPose> parseTum(std::istream& in, const std::string& file);
+
+/// A sequence folder: the clouds (*.pcd, *.ply, sorted by name: time order) and DIR/poses.tum
+/// with one pose per cloud, in the same order. Throws std::runtime_error when the counts differ.
+struct Sequence {
+  std::vector<std::string> clouds;
+  std::vector<StampedPose> truth;
+};
+Sequence readSequence(const std::string& dir);
+
 }  // namespace cube_scan_matcher::io

@@ -39,4 +39,9 @@ struct SweepOptions {
 PointArray scan(const Scene& scene, const ScannerModel& model, const Eigen::Isometry3d& sensor_pose,
                 std::mt19937_64& rng, const SweepOptions& options = {});
 
+/// One sweep from a robot at `body` (T_world_base) with the sensor mounted at the base's
+/// origin (sensorToBodyRotation()), returned in the base frame (REP-103 axes).
+PointArray scanInBody(const Scene& scene, const ScannerModel& model, const Eigen::Isometry3d& body,
+                      std::mt19937_64& rng);
+
 }  // namespace cube_scan_matcher::sim

@@ -1,0 +1,61 @@
+#!/usr/bin/env python3
+"""Trajectories (x-y) of every method against the truth, one panel per sequence_benchmark CSV,
+and the summary CSV as a markdown table.
+
+usage: /usr/bin/python3 scripts/plot_sequence.py OUT.png RUN.csv [RUN.csv ...]
+       /usr/bin/python3 scripts/plot_sequence.py --table SUMMARY.csv
+"""
+import csv
+import sys
+
+import matplotlib
+
+matplotlib.use("Agg")
+import matplotlib.pyplot as plt  # noqa: E402
+
+
+def table(path):
+    def cell(pct, deg):
+        return "-" if pct == "" else "%.2f %% / %.4f" % (float(pct), float(deg))
+
+    print("| run | odometry | method | scans | m | accepted / rejected | RPE 10 m | RPE 50 m | "
+          "RPE 100 m | ATE m | standing still m / deg | median s |")
+    print("|---|---|---|---|---|---|---|---|---|---|---|---|")
+    with open(path) as fh:
+        for r in csv.DictReader(fh):
+            print("| %s | %s | %s | %s | %.0f | %s / %s | %s | %s | %s | %.3f | %s | %.3f |" % (
+                r["label"], r["odometry"], r["method"], r["scans"], float(r["length_m"]),
+                r["accepted"], r["rejected"], cell(r["rpe10_pct"], r["rpe10_deg_m"]),
+                cell(r["rpe50_pct"], r["rpe50_deg_m"]), cell(r["rpe100_pct"], r["rpe100_deg_m"]),
+                float(r["ate_m"]),
+                "-" if r["still_scans"] == "0" else "%.3f / %.2f" % (float(r["still_m"]), float(r["still_deg"])),
+                float(r["median_time_s"])))
+
+
+def plot(out, files):
+    fig, axes = plt.subplots(len(files), 1, figsize=(10, 3.2 * len(files)), squeeze=False)
+    for ax, f in zip(axes[:, 0], files):
+        runs = {}
+        with open(f) as fh:
+            for r in csv.DictReader(fh):
+                runs.setdefault(r["method"], []).append(r)
+        first = next(iter(runs.values()))
+        ax.plot([float(r["truth_x"]) for r in first], [float(r["truth_y"]) for r in first],
+                "k-", lw=2, label="truth")
+        for name, rows in runs.items():
+            ax.plot([float(r["x"]) for r in rows], [float(r["y"]) for r in rows], lw=1, label=name)
+        ax.set_title("%s, odometry %s" % (first[0]["label"], first[0]["odometry"]))
+        ax.set_xlabel("x [m]")
+        ax.set_ylabel("y [m]")
+        ax.legend(fontsize=7, loc="best")
+    fig.tight_layout()
+    fig.savefig(out, dpi=90)
+
+
+if __name__ == "__main__":
+    if len(sys.argv) == 3 and sys.argv[1] == "--table":
+        table(sys.argv[2])
+    elif len(sys.argv) >= 3:
+        plot(sys.argv[1], sys.argv[2:])
+    else:
+        sys.exit(__doc__)

@@ -1,0 +1,79 @@
+#include "cube_scan_matcher/sim/sequence_motion.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include "cube_scan_matcher/core/pose.h"
+
+namespace cube_scan_matcher::sim {
+
+SequenceMotion::SequenceMotion(const Scene& scene, const SequenceSettings& settings,
+                               std::uint64_t seed)
+    : scene_(scene), s_(settings), rng_(seed) {
+  left_ = s_.drive_sweeps;
+  place();
+}
+
+void SequenceMotion::place() {
+  // Pitch and roll of a robot standing on the ground: the slope over its 1 m footprint.
+  const double h = 0.5, c = std::cos(heading_), s = std::sin(heading_);
+  const double z = scene_.groundHeight(x_, y_);
+  const double front = scene_.groundHeight(x_ + h * c, y_ + h * s) - scene_.groundHeight(x_ - h * c, y_ - h * s);
+  const double left = scene_.groundHeight(x_ - h * s, y_ + h * c) - scene_.groundHeight(x_ + h * s, y_ - h * c);
+  const double pitch = -std::atan2(front, 2 * h), roll = std::atan2(left, 2 * h);
+  pose_.linear() = rotationFromRpy(roll, pitch, heading_);
+  pose_.translation() = Eigen::Vector3d(x_, y_, z + s_.height);
+}
+
+void SequenceMotion::advance() {
+  const double turn = deg2rad(s_.turn_step_deg);
+  const int quarter = std::max(1, int(std::lround(90.0 / s_.turn_step_deg)));
+  auto next = [&](Phase p, int sweeps) { phase_ = p, left_ = sweeps; };
+  switch (phase_) {
+    case Phase::Drive: {
+      const bool beyond = (axis_ == 0.0 && x_ > s_.x_max) || (axis_ != 0.0 && x_ < s_.x_min);
+      if (beyond) {
+        next(Phase::TurnRound, 2 * quarter);
+        axis_ = axis_ == 0.0 ? M_PI : 0.0;
+        return advance();
+      }
+      if (left_-- <= 0) {
+        next(Phase::Stand, s_.stand_sweeps);
+        return advance();
+      }
+      const double jitter = deg2rad(s_.heading_jitter_deg), hmax = deg2rad(s_.heading_max_deg);
+      double rel = wrapAngle(heading_ - axis_) + std::uniform_real_distribution<double>(-jitter, jitter)(rng_);
+      rel = std::clamp(rel, -hmax, hmax);
+      const double side = axis_ == 0.0 ? 1.0 : -1.0;  // +y is left when driving along +x
+      if (std::abs(y_) > s_.lateral_limit) rel = (y_ * side > 0 ? -1.0 : 1.0) * std::abs(rel);
+      heading_ = wrapAngle(axis_ + rel);
+      x_ += s_.step * std::cos(heading_);
+      y_ += s_.step * std::sin(heading_);
+      break;
+    }
+    case Phase::Stand:
+      if (left_-- <= 0) {
+        next(Phase::LookOut, quarter);
+        return advance();
+      }
+      break;
+    case Phase::LookOut:
+      heading_ = wrapAngle(heading_ + look_ * turn);
+      if (--left_ <= 0) next(Phase::LookBack, quarter);
+      break;
+    case Phase::LookBack:
+      heading_ = wrapAngle(heading_ - look_ * turn);
+      if (--left_ <= 0) next(Phase::Drive, s_.drive_sweeps), look_ = -look_;
+      break;
+    case Phase::TurnRound:
+      heading_ = wrapAngle(heading_ + turn);
+      if (--left_ <= 0) {
+        heading_ = axis_;
+        next(Phase::Drive, s_.drive_sweeps);
+      }
+      break;
+  }
+  place();
+}
+
+}  // namespace cube_scan_matcher::sim

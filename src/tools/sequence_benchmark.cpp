@@ -1,0 +1,369 @@
+// sequence_benchmark: runs the online matcher (OnlineMatcher, the nodelet's core) over a whole
+// sequence and reports drift, beside PCL peers chained the same way in the same run.
+//   sequence_benchmark --scene urban --length 500 --odometry big       (simulated, exact truth)
+//   sequence_benchmark --dir ../shared/data/balm_os0_hall_seq_a --odometry big   (real + poses.tum)
+// Metrics: relative pose error per 10/50/100 m (% and deg/m), ATE after a rigid alignment,
+// drift while standing still, accepted / rejected scans, median time per scan.
+#include <chrono>
+#include <cstdio>
+#include <fstream>
+#include <functional>
+#include <iostream>
+#include <memory>
+#include <random>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "cube_scan_matcher/core/metrics.h"
+#include "cube_scan_matcher/core/online_matcher.h"
+#include "cube_scan_matcher/core/trajectory_metrics.h"
+#include "cube_scan_matcher/io/cloud_io.h"
+#include "cube_scan_matcher/sim/motion.h"
+#include "cube_scan_matcher/sim/sequence_motion.h"
+#include "cube_scan_matcher/sim/tilting_scanner.h"
+#include "peer_methods.h"
+#include "settings_cli.h"
+
+using namespace cube_scan_matcher;
+using namespace cube_scan_matcher::tools;
+
+namespace {
+
+void usage(std::ostream& os) {
+  os << "usage: sequence_benchmark (--scene NAME | --dir DIR) [options]\n"
+        "  --scene NAME          simulated run: hall, urban, park or natural\n"
+        "  --length M            simulated path length [m] (default 500)\n"
+        "  --seed N              world, trajectory and noise seed (default 1)\n"
+        "  --dir DIR             real sequence: DIR/*.pcd|*.ply in name order + DIR/poses.tum\n"
+        "  --odometry MODE       none, small, big, drift: odometry = truth with the simulator's\n"
+        "                        errors per increment (motion.h); cv: no odometry, constant\n"
+        "                        velocity from each method's own estimate; identity: no\n"
+        "                        odometry, no motion (default big)\n"
+        "  --period S            simulated time between sweeps [s] (default 1.5)\n"
+        "  --methods LIST        comma list of cubes (package defaults: keyframes and a\n"
+        "                        submap), cubes-s2s (every scan a keyframe, no submap: scan\n"
+        "                        to scan), cubes-submap (--submap keyframes merged),\n"
+        "                        gicp, ndt, icp (PCL on --voxel copies, scan to scan)\n"
+        "                        (default cubes,cubes-s2s,gicp,ndt)\n"
+        "  --submap K            keyframes merged in cubes-submap (default 3)\n"
+        "  --keyframe-distance M, --keyframe-angle DEG   keyframe thresholds of the cube methods\n"
+        "  --voxel L             peers' voxel leaf [m] (default 0.2)\n"
+        "  --csv FILE            per-scan trajectories (default sequence.csv)\n"
+        "  --summary FILE        one line per method appended (default: none)\n"
+        "  --label TEXT          run label in the CSVs (default: scene or folder name)\n"
+        "  --check-pct P, --check-deg-m D, --check-still-m S, --check-rejected N\n"
+        "                        exit 2 unless every cube method's relative error over the\n"
+        "                        longest of 100/50/10 m segments the run has is <= P %% and\n"
+        "                        <= D deg/m, its standing-still drift <= S m and its rejected\n"
+        "                        scans <= N (for CI)\n"
+     << algorithmOptionsHelp();
+}
+
+double yawDeg(const Eigen::Isometry3d& T) { return rad2deg(isometryToPose(T)[5]); }
+
+/// One method's chain over the sequence.
+struct Method {
+  std::string name;
+  Trajectory poses;
+  std::vector<double> times;
+  int accepted = 0, rejected = 0;
+  /// Processes scan k; `odom` is the odometry (T_odom_base) when the mode has one.
+  std::function<void(Method&, const PointArray&, double, const std::optional<Eigen::Isometry3d>&)> step;
+};
+
+/// T with its rotation projected onto SO(3) (nearest rotation, by SVD): a diverged peer
+/// can return a matrix that is not rigid, and a chain must not compound it.
+Eigen::Isometry3d rigidPart(const Eigen::Isometry3d& T) {
+  Eigen::JacobiSVD<Eigen::Matrix3d> svd(T.linear(), Eigen::ComputeFullU | Eigen::ComputeFullV);
+  Eigen::Matrix3d R = svd.matrixU() * svd.matrixV().transpose();
+  if (R.determinant() < 0) {
+    Eigen::Matrix3d U = svd.matrixU();
+    U.col(2) *= -1.0;
+    R = U * svd.matrixV().transpose();
+  }
+  Eigen::Isometry3d out = Eigen::Isometry3d::Identity();
+  out.linear() = R;
+  out.translation() = T.translation();
+  return out;
+}
+
+/// The previous estimate's motion, as a guess for the next increment (constant velocity).
+Eigen::Isometry3d lastMotion(const Trajectory& poses) {
+  if (poses.size() < 2) return Eigen::Isometry3d::Identity();
+  return poses[poses.size() - 2].inverse() * poses.back();
+}
+
+Method cubeMethod(const std::string& name, const OnlineMatcherSettings& settings,
+                  const RangeFilterSettings& filter, bool constant_velocity) {
+  Method m;
+  m.name = name;
+  OnlineMatcherSettings s = settings;
+  s.constant_velocity = constant_velocity;
+  auto matcher = std::make_shared<OnlineMatcher>(s);
+  m.step = [matcher, filter](Method& self, const PointArray& points, double stamp,
+                             const std::optional<Eigen::Isometry3d>& odom) {
+    const auto t0 = std::chrono::steady_clock::now();
+    const OnlineStep st = matcher->process(filterPoints(points, filter), stamp, odom);
+    self.times.push_back(std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
+    if (st.registered) (st.accepted ? self.accepted : self.rejected)++;
+    if (st.registered && !st.accepted) {
+      std::fprintf(stderr, "%s scan %zu: %s\n", self.name.c_str(), self.poses.size(), st.message.c_str());
+    }
+    self.poses.push_back(st.pose);
+  };
+  return m;
+}
+
+using PeerFn = PeerResult (*)(const Cloud::ConstPtr&, const Cloud::ConstPtr&, const Eigen::Isometry3d&);
+
+/// A PCL peer chained scan to scan: the guess is the odometry increment, the last motion
+/// (cv) or identity. PCL gives no acceptance test of its own: a result is used when it is finite
+/// and within the cube method's correction gate (max_correction_*) of the guess.
+Method peerMethod(const std::string& name, PeerFn fn, double voxel, bool constant_velocity,
+                  const GateSettings& gate) {
+  Method m;
+  m.name = name;
+  struct State {
+    Cloud::Ptr previous;
+    std::optional<Eigen::Isometry3d> previous_odom;
+  };
+  auto state = std::make_shared<State>();
+  m.step = [state, fn, voxel, constant_velocity, gate](Method& self, const PointArray& points, double,
+                                                 const std::optional<Eigen::Isometry3d>& odom) {
+    const auto t0 = std::chrono::steady_clock::now();
+    Cloud::Ptr cloud = voxelCopy(toPcl(points), float(voxel));
+    Eigen::Isometry3d pose = odom ? *odom : Eigen::Isometry3d::Identity();
+    if (state->previous) {
+      Eigen::Isometry3d guess = Eigen::Isometry3d::Identity();
+      if (odom && state->previous_odom) guess = state->previous_odom->inverse() * *odom;
+      else if (constant_velocity) guess = lastMotion(self.poses);
+      const PeerResult r = fn(cloud, state->previous, guess);
+      const Eigen::Isometry3d correction = guess.inverse() * r.estimate;
+      const bool rigid = r.estimate.matrix().allFinite() &&
+                         (r.estimate.linear().transpose() * r.estimate.linear() -
+                          Eigen::Matrix3d::Identity()).norm() < 1e-4;
+      if (rigid && correction.translation().norm() <= gate.max_correction_m &&
+          Eigen::AngleAxisd(correction.linear()).angle() <= gate.max_correction_rad) {
+        pose = self.poses.back() * r.estimate;
+        ++self.accepted;
+      } else {  // diverged (not finite, not rigid) or beyond the cubes' correction gate:
+                // the chain goes on with the guess
+        pose = self.poses.back() * guess;
+        ++self.rejected;
+      }
+    }
+    self.times.push_back(std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
+    state->previous = cloud;
+    state->previous_odom = odom;
+    self.poses.push_back(rigidPart(pose));
+  };
+  return m;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  std::vector<std::string> args(argv + 1, argv + argc);
+  std::string scene_name, dir, odometry_mode = "big", csv_path = "sequence.csv", summary_path, label;
+  double length = 500.0, period = 1.5, voxel = 0.2;
+  std::uint64_t seed = 1;
+  int submap = 3;
+  double check_pct = -1, check_deg_m = -1, check_still_m = -1, check_rejected = -1;
+  std::vector<std::string> methods = {"cubes", "cubes-s2s", "gicp", "ndt"};
+  OnlineMatcherSettings matcher_settings;
+  RangeFilterSettings filter;
+  try {
+    for (std::size_t i = 0; i < args.size();) {
+      const std::string& a = args[i];
+      if (a == "-h" || a == "--help") return usage(std::cout), 0;
+      if (parseAlgorithmOption(args, i, matcher_settings.registration, filter)) continue;
+      if (i + 1 >= args.size()) throw std::invalid_argument(a + ": missing value or unknown option");
+      const std::string v = args[i + 1];
+      if (a == "--scene") scene_name = v;
+      else if (a == "--dir") dir = v;
+      else if (a == "--length") length = io::parseNumber(a, v);
+      else if (a == "--seed") seed = std::uint64_t(io::parseNumber(a, v));
+      else if (a == "--odometry") odometry_mode = v;
+      else if (a == "--period") period = io::parseNumber(a, v);
+      else if (a == "--methods") methods = splitList(v);
+      else if (a == "--submap") submap = int(io::parseNumber(a, v));
+      else if (a == "--keyframe-distance") matcher_settings.keyframes.distance = io::parseNumber(a, v);
+      else if (a == "--keyframe-angle") matcher_settings.keyframes.angle = deg2rad(io::parseNumber(a, v));
+      else if (a == "--voxel") voxel = io::parseNumber(a, v);
+      else if (a == "--csv") csv_path = v;
+      else if (a == "--summary") summary_path = v;
+      else if (a == "--label") label = v;
+      else if (a == "--check-pct") check_pct = io::parseNumber(a, v);
+      else if (a == "--check-deg-m") check_deg_m = io::parseNumber(a, v);
+      else if (a == "--check-still-m") check_still_m = io::parseNumber(a, v);
+      else if (a == "--check-rejected") check_rejected = io::parseNumber(a, v);
+      else throw std::invalid_argument("unknown option or value: " + a + " " + v);
+      i += 2;
+    }
+    if (scene_name.empty() == dir.empty()) throw std::invalid_argument("give one of --scene or --dir");
+    if (!(length > 0.0) || !(period > 0.0) || !(voxel > 0.0)) {
+      throw std::invalid_argument("--length, --period and --voxel must be > 0");
+    }
+    const bool cv = odometry_mode == "cv", identity = odometry_mode == "identity";
+    const bool has_odometry = !cv && !identity;
+    const sim::OdometryError error_model =
+        has_odometry ? sim::odometryErrorFromString(odometry_mode) : sim::OdometryError::None;
+    validate(matcher_settings);
+    validate(filter);
+
+    std::vector<Method> table;
+    for (const std::string& m : methods) {
+      OnlineMatcherSettings s = matcher_settings;
+      if (m == "cubes") table.push_back(cubeMethod(m, s, filter, !identity));
+      else if (m == "cubes-s2s") {
+        s.keyframes.distance = 0.0, s.keyframes.angle = 0.0, s.keyframes.interval = 0.0;
+        s.keyframes.submap_size = 1;
+        table.push_back(cubeMethod(m, s, filter, !identity));
+      } else if (m == "cubes-submap") {
+        s.keyframes.submap_size = submap;
+        table.push_back(cubeMethod(m + std::to_string(submap), s, filter, !identity));
+      } else if (m == "gicp") table.push_back(peerMethod(m, runGicp, voxel, cv, matcher_settings.gate));
+      else if (m == "ndt") table.push_back(peerMethod(m, runNdt, voxel, cv, matcher_settings.gate));
+      else if (m == "icp") table.push_back(peerMethod(m, runIcp, voxel, cv, matcher_settings.gate));
+      else throw std::invalid_argument("unknown method: " + m);
+    }
+
+    // The scans: simulated on the fly, or read from the folder.
+    std::optional<sim::Scene> scene;
+    std::unique_ptr<sim::SequenceMotion> robot;
+    io::Sequence sequence;
+    std::size_t count = 0;
+    if (!scene_name.empty()) {
+      scene = sim::Scene::generate(sim::sceneTypeFromString(scene_name), seed);
+      robot = std::make_unique<sim::SequenceMotion>(*scene, sim::SequenceSettings{}, seed + 1);
+      if (label.empty()) label = scene_name;
+    } else {
+      sequence = io::readSequence(dir);
+      count = sequence.clouds.size();
+      if (label.empty()) label = dir.substr(dir.find_last_of('/') + 1);
+    }
+    sim::OdometrySimulator odometry(error_model, seed + 2);
+    std::mt19937_64 rng(seed);
+    const sim::ScannerModel model;
+
+    Trajectory truth;
+    std::vector<double> distance;
+    double travelled = 0.0;
+    for (std::size_t k = 0;; ++k) {
+      PointArray points;
+      Eigen::Isometry3d pose;
+      double stamp;
+      if (robot) {
+        if (travelled >= length) break;
+        if (k > 0) robot->advance();
+        pose = robot->pose();
+        stamp = double(k) * period;
+        points = sim::scanInBody(*scene, model, pose, rng);
+      } else {
+        if (k == count) break;
+        // Truth relative to the first pose: the estimate starts at the truth's first pose.
+        pose = sequence.truth[0].pose.inverse() * sequence.truth[k].pose;
+        stamp = sequence.truth[k].stamp;
+        points = io::readCloudFile(sequence.clouds[k]);
+      }
+      if (!truth.empty()) travelled += (pose.translation() - truth.back().translation()).norm();
+      truth.push_back(pose);
+      std::optional<Eigen::Isometry3d> odom;
+      if (has_odometry) odom = odometry.next(pose);
+      for (Method& m : table) m.step(m, points, stamp, odom);
+      if (k % 25 == 0) std::fprintf(stderr, "scan %zu, %.0f m\n", k, travelled);
+    }
+
+    std::ofstream csv(csv_path);
+    if (!csv) throw std::runtime_error(csv_path + ": cannot write");
+    csv << "label,odometry,method,scan,time_s,truth_x,truth_y,truth_z,truth_yaw_deg,x,y,z,yaw_deg\n";
+    for (const Method& m : table) {
+      for (std::size_t k = 0; k < truth.size(); ++k) {
+        const Eigen::Vector3d t = truth[k].translation(), e = m.poses[k].translation();
+        csv << label << ',' << odometry_mode << ',' << m.name << ',' << k << ',' << m.times[k] << ','
+            << t.x() << ',' << t.y() << ',' << t.z() << ',' << yawDeg(truth[k]) << ',' << e.x()
+            << ',' << e.y() << ',' << e.z() << ',' << yawDeg(m.poses[k]) << '\n';
+      }
+    }
+    std::ofstream summary;
+    if (!summary_path.empty()) {
+      const bool fresh = !std::ifstream(summary_path).good();
+      summary.open(summary_path, std::ios::app);
+      if (!summary) throw std::runtime_error(summary_path + ": cannot write");
+      if (fresh) {
+        summary << "label,odometry,method,scans,length_m,accepted,rejected,rpe10_pct,rpe10_deg_m,"
+                   "rpe50_pct,rpe50_deg_m,rpe100_pct,rpe100_deg_m,ate_m,still_scans,still_m,"
+                   "still_deg,median_time_s\n";
+      }
+    }
+    const StationaryDrift still_truth = stationaryDrift(truth, truth);
+    std::printf("%s, odometry %s: %zu scans, %.1f m, %d standing-still runs (%d scans)\n",
+                label.c_str(), odometry_mode.c_str(), truth.size(), travelled,
+                still_truth.segments, still_truth.scans);
+    std::printf("%-14s %6s %6s %14s %14s %14s %8s %14s %9s\n", "method", "acc", "rej",
+                "RPE10 %|deg/m", "RPE50 %|deg/m", "RPE100 %|deg/m", "ATE m", "still m|deg",
+                "median s");
+    std::vector<std::string> failures;
+    for (const Method& m : table) {
+      RelativeError r[3];
+      const double lengths[3] = {10.0, 50.0, 100.0};
+      for (int i = 0; i < 3; ++i) r[i] = relativePoseError(truth, m.poses, lengths[i]);
+      const double ate = absoluteTrajectoryError(truth, m.poses);
+      const StationaryDrift sd = stationaryDrift(truth, m.poses);
+      const double t_med = quantile(m.times, 0.5);
+      auto cell = [](const RelativeError& e) {
+        char b[32];
+        if (e.segments == 0) std::snprintf(b, sizeof b, "-");
+        else std::snprintf(b, sizeof b, "%.2f|%.4f", e.translation_pct, e.rotation_deg_per_m);
+        return std::string(b);
+      };
+      std::printf("%-14s %6d %6d %14s %14s %14s %8.3f %8.3f|%.2f %9.3f\n", m.name.c_str(),
+                  m.accepted, m.rejected, cell(r[0]).c_str(), cell(r[1]).c_str(), cell(r[2]).c_str(),
+                  ate, sd.translation, sd.rotation_deg, t_med);
+      if (summary.is_open()) {
+        summary << label << ',' << odometry_mode << ',' << m.name << ',' << truth.size() << ','
+                << travelled << ',' << m.accepted << ',' << m.rejected;
+        for (const RelativeError& e : r) {
+          if (e.segments == 0) summary << ",,";
+          else summary << ',' << e.translation_pct << ',' << e.rotation_deg_per_m;
+        }
+        summary << ',' << ate << ',' << sd.scans << ',' << sd.translation << ',' << sd.rotation_deg
+                << ',' << t_med << '\n';
+      }
+      if (m.name.rfind("cubes", 0) == 0) {
+        const RelativeError* longest = nullptr;
+        for (const RelativeError& e : r) {
+          if (e.segments > 0) longest = &e;
+        }
+        char b[160];
+        if (longest && check_pct >= 0 && longest->translation_pct > check_pct) {
+          std::snprintf(b, sizeof b, "%s: %.2f %% over %.0f m > %.2f %%", m.name.c_str(),
+                        longest->translation_pct, longest->length, check_pct);
+          failures.push_back(b);
+        }
+        if (longest && check_deg_m >= 0 && longest->rotation_deg_per_m > check_deg_m) {
+          std::snprintf(b, sizeof b, "%s: %.4f deg/m over %.0f m > %.4f", m.name.c_str(),
+                        longest->rotation_deg_per_m, longest->length, check_deg_m);
+          failures.push_back(b);
+        }
+        if (check_still_m >= 0 && sd.translation > check_still_m) {
+          std::snprintf(b, sizeof b, "%s: standing-still drift %.3f m > %.3f m", m.name.c_str(),
+                        sd.translation, check_still_m);
+          failures.push_back(b);
+        }
+        if (check_rejected >= 0 && m.rejected > check_rejected) {
+          std::snprintf(b, sizeof b, "%s: %d scans rejected > %.0f", m.name.c_str(), m.rejected,
+                        check_rejected);
+          failures.push_back(b);
+        }
+      }
+    }
+    for (const std::string& f : failures) std::fprintf(stderr, "CHECK FAILED %s\n", f.c_str());
+    if (!failures.empty()) return 2;
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "sequence_benchmark: %s\n", e.what());
+    return 1;
+  }
+  return 0;
+}
