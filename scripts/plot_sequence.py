@@ -4,8 +4,12 @@ and the summary CSV as a markdown table.
 
 usage: /usr/bin/python3 scripts/plot_sequence.py OUT.png RUN.csv [RUN.csv ...]
        /usr/bin/python3 scripts/plot_sequence.py --table SUMMARY.csv
+       /usr/bin/python3 scripts/plot_sequence.py --steps RUN.csv [RUN.csv ...]
+--steps counts, per method, the increments between consecutive scans whose planar error
+(x, y, yaw) against the truth's is >= 0.1 m or >= 1 deg: one bad registration each.
 """
 import csv
+import math
 import sys
 
 import matplotlib
@@ -32,6 +36,36 @@ def table(path):
                 float(r["median_time_s"])))
 
 
+def planar(r, prefix):
+    return float(r[prefix + "x"]), float(r[prefix + "y"]), math.radians(float(r[prefix + "yaw_deg"]))
+
+
+def between(a, b):
+    """Planar b relative to a."""
+    dx, dy, c, s = b[0] - a[0], b[1] - a[1], math.cos(a[2]), math.sin(a[2])
+    return c * dx + s * dy, -s * dx + c * dy, b[2] - a[2]
+
+
+def steps(files):
+    print("| run | odometry | method | increments off (>= 0.1 m or 1 deg) |")
+    print("|---|---|---|---|")
+    for f in files:
+        runs = {}
+        with open(f) as fh:
+            for r in csv.DictReader(fh):
+                runs.setdefault(r["method"], []).append(r)
+        for name, rows in runs.items():
+            off = 0
+            for p, q in zip(rows, rows[1:]):
+                t = between(planar(p, "truth_"), planar(q, "truth_"))
+                e = between(planar(p, ""), planar(q, ""))
+                err = between(t, e)
+                yaw = (err[2] + math.pi) % (2 * math.pi) - math.pi
+                off += math.hypot(err[0], err[1]) >= 0.1 or abs(math.degrees(yaw)) >= 1.0
+            print("| %s | %s | %s | %d of %d |" % (rows[0]["label"], rows[0]["odometry"], name, off,
+                                                   len(rows) - 1))
+
+
 def plot(out, files):
     fig, axes = plt.subplots(len(files), 1, figsize=(10, 3.2 * len(files)), squeeze=False)
     for ax, f in zip(axes[:, 0], files):
@@ -55,6 +89,8 @@ def plot(out, files):
 if __name__ == "__main__":
     if len(sys.argv) == 3 and sys.argv[1] == "--table":
         table(sys.argv[2])
+    elif len(sys.argv) >= 3 and sys.argv[1] == "--steps":
+        steps(sys.argv[2:])
     elif len(sys.argv) >= 3:
         plot(sys.argv[1], sys.argv[2:])
     else:

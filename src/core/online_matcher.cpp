@@ -158,7 +158,8 @@ OnlineStep OnlineMatcher::process(const PointArray& points, double stamp,
     wide.gnmm.bounds *= step.gate_scale;
     if (step.gate_scale > 1.0) registration_.setSettings(wide);
     step.result = registration_.align(points, step.guess);
-    if (!step.odometry_guess && settings_.constant_velocity && last_known_) {
+    if (!step.odometry_guess && settings_.constant_velocity && settings_.no_motion_candidate &&
+        last_known_) {
       // Constant velocity fails where the motion changes most (a turn on the spot that starts,
       // stops or reverses): the no-motion guess is searched too, and the higher J wins.
       const Pose6 still = isometryToPose(keyframe->pose.inverse() * last_known_->pose);

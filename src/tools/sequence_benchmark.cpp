@@ -41,6 +41,7 @@ void usage(std::ostream& os) {
         "                        velocity from each method's own estimate; identity: no\n"
         "                        odometry, no motion (default big)\n"
         "  --period S            simulated time between sweeps [s] (default 1.5)\n"
+        "  --step M              simulated travel per sweep while driving [m] (default 1.5)\n"
         "  --methods LIST        comma list of cubes (package defaults: keyframes and a\n"
         "                        submap), cubes-s2s (every scan a keyframe, no submap: scan\n"
         "                        to scan), cubes-submap (--submap keyframes merged),\n"
@@ -48,6 +49,7 @@ void usage(std::ostream& os) {
         "                        (default cubes,cubes-s2s,gicp,ndt)\n"
         "  --submap K            keyframes merged in cubes-submap (default 3)\n"
         "  --keyframe-distance M, --keyframe-angle DEG   keyframe thresholds of the cube methods\n"
+        "  --no-motion-candidate 0|1  without odometry, also search from no motion (default 1)\n"
         "  --voxel L             peers' voxel leaf [m] (default 0.2)\n"
         "  --csv FILE            per-scan trajectories (default sequence.csv)\n"
         "  --summary FILE        one line per method appended (default: none)\n"
@@ -167,6 +169,7 @@ int main(int argc, char** argv) {
   std::vector<std::string> args(argv + 1, argv + argc);
   std::string scene_name, dir, odometry_mode = "big", csv_path = "sequence.csv", summary_path, label;
   double length = 500.0, period = 1.5, voxel = 0.2;
+  sim::SequenceSettings motion;
   std::uint64_t seed = 1;
   int submap = 3;
   double check_pct = -1, check_deg_m = -1, check_still_m = -1, check_rejected = -1;
@@ -186,11 +189,13 @@ int main(int argc, char** argv) {
       else if (a == "--seed") seed = std::uint64_t(io::parseNumber(a, v));
       else if (a == "--odometry") odometry_mode = v;
       else if (a == "--period") period = io::parseNumber(a, v);
+      else if (a == "--step") motion.step = io::parseNumber(a, v);
       else if (a == "--methods") methods = splitList(v);
       else if (a == "--submap") submap = int(io::parseNumber(a, v));
       else if (a == "--keyframe-distance") matcher_settings.keyframes.distance = io::parseNumber(a, v);
       else if (a == "--keyframe-angle") matcher_settings.keyframes.angle = deg2rad(io::parseNumber(a, v));
       else if (a == "--voxel") voxel = io::parseNumber(a, v);
+      else if (a == "--no-motion-candidate") matcher_settings.no_motion_candidate = io::parseNumber(a, v) != 0.0;
       else if (a == "--csv") csv_path = v;
       else if (a == "--summary") summary_path = v;
       else if (a == "--label") label = v;
@@ -202,8 +207,8 @@ int main(int argc, char** argv) {
       i += 2;
     }
     if (scene_name.empty() == dir.empty()) throw std::invalid_argument("give one of --scene or --dir");
-    if (!(length > 0.0) || !(period > 0.0) || !(voxel > 0.0)) {
-      throw std::invalid_argument("--length, --period and --voxel must be > 0");
+    if (!(length > 0.0) || !(period > 0.0) || !(voxel > 0.0) || !(motion.step > 0.0)) {
+      throw std::invalid_argument("--length, --period, --step and --voxel must be > 0");
     }
     const bool cv = odometry_mode == "cv", identity = odometry_mode == "identity";
     const bool has_odometry = !cv && !identity;
@@ -236,7 +241,7 @@ int main(int argc, char** argv) {
     std::size_t count = 0;
     if (!scene_name.empty()) {
       scene = sim::Scene::generate(sim::sceneTypeFromString(scene_name), seed);
-      robot = std::make_unique<sim::SequenceMotion>(*scene, sim::SequenceSettings{}, seed + 1);
+      robot = std::make_unique<sim::SequenceMotion>(*scene, motion, seed + 1);
       if (label.empty()) label = scene_name;
     } else {
       sequence = io::readSequence(dir);

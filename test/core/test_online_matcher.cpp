@@ -107,7 +107,9 @@ TEST(OnlineMatcher, OdometryGapIsBridgedFromTheLastScanWithOdometry) {
   motion.step_min = 0.3, motion.step_max = 0.5, motion.yaw_change_max_deg = 3.0;
   sim::RobotMotion robot(scene, motion, 9);
   std::mt19937_64 rng(7);
-  OnlineMatcher m{OnlineMatcherSettings{}};
+  OnlineMatcherSettings every_scan;
+  every_scan.keyframes.distance = 0.0;  // each scan the keyframe: the guess is scan to scan
+  OnlineMatcher m(every_scan);
   // Odometry with a constant offset from the truth: map = odom o offset.
   Eigen::Isometry3d offset = Eigen::Isometry3d::Identity();
   offset.translation() = Eigen::Vector3d(5.0, -3.0, 0.2);
@@ -132,7 +134,7 @@ TEST(OnlineMatcher, OdometryGapIsBridgedFromTheLastScanWithOdometry) {
   }
 
   // No odometry and a rejected registration (far outside the gate): not the reference.
-  OnlineMatcherSettings tight;
+  OnlineMatcherSettings tight = every_scan;
   tight.gate.max_correction_m = 1e-3;
   tight.max_consecutive_rejections = 3;
   m.setSettings(tight);

@@ -219,10 +219,10 @@ TEST_F(ScanMatcherRos, BadInputKeepsTheNodeAliveAndIsReported) {
   EXPECT_EQ(s.reason, Status::ACCEPTED) << s.message;
   EXPECT_EQ(s.points_valid, good.size());
 
-  // Absurd coordinates: the grid's memory cap refuses the scan as a reference (it moved 0.8 m,
+  // Absurd coordinates: the grid's memory cap refuses the scan as a reference (it moved 1.1 m,
   // beyond keyframe_distance, so it would be the next keyframe), nothing crashes.
   PointArray absurd;
-  for (std::size_t i = 0; i < good.size(); ++i) absurd.push_back(good.x[i] - 0.8f, good.y[i], good.z[i]);
+  for (std::size_t i = 0; i < good.size(); ++i) absurd.push_back(good.x[i] - 1.1f, good.y[i], good.z[i]);
   absurd.push_back(1e6f, 1e6f, 1e6f);
   s = send(makeCloud(absurd, "base_link", next()));
   EXPECT_FALSE(s.reference_updated);

@@ -22,8 +22,8 @@ namespace cube_scan_matcher {
 /// distance: every accepted scan is a keyframe (scan-to-scan chaining). A scan that did not
 /// move far enough is registered to the same keyframe, so standing still adds no drift.
 struct KeyframeSettings {
-  double distance = 0.5;
-  double angle = 5.0 * EIGEN_PI / 180.0;
+  double distance = 1.0;
+  double angle = 10.0 * EIGEN_PI / 180.0;
   double interval = 0.0;
   /// Keyframes merged into the reference (1 = the last keyframe only), in [1, 20].
   int submap_size = 3;
@@ -36,6 +36,9 @@ struct OnlineMatcherSettings {
   /// Without odometry, predict a scan from the last registered motion per second (constant
   /// velocity) instead of from no motion.
   bool constant_velocity = true;
+  /// With constant_velocity and no odometry, also search from "no motion" (the last registered
+  /// pose) and keep the higher J.
+  bool no_motion_candidate = true;
   /// Without odometry the prediction is uncertain (the robot may start, stop or turn on the
   /// spot): the search's restart bounds and the gate's correction bounds are multiplied by
   /// this (as by OnlineStep::gate_scale, the larger of the two). In [1, 10].
