@@ -54,12 +54,7 @@ PointArray OnlineMatcher::submapPoints(const std::deque<Keyframe>& keyframes, in
   PointArray merged;
   const Eigen::Isometry3d to_newest = keyframes.back().pose.inverse();
   for (std::size_t i = keyframes.size() - n; i < keyframes.size(); ++i) {
-    const Eigen::Matrix4f T = (to_newest * keyframes[i].pose).matrix().cast<float>();
-    const PointArray& p = keyframes[i].points;
-    for (std::size_t j = 0; j < p.size(); ++j) {
-      const Eigen::Vector3f q = T.topLeftCorner<3, 3>() * p.point(j) + T.topRightCorner<3, 1>();
-      merged.push_back(q.x(), q.y(), q.z());
-    }
+    appendTransformed(merged, keyframes[i].points, to_newest * keyframes[i].pose);
   }
   return merged;
 }
@@ -222,7 +217,7 @@ OnlineStep OnlineMatcher::process(const PointArray& points, double stamp,
     if (!step.message.empty()) step.message += "; ";
     step.message += "scan not used as reference: the registration was rejected";
   }
-  step.keyframes = int(std::min(keyframes_.size(), std::size_t(settings_.keyframes.submap_size)));
+  step.keyframes = int(keyframes_.size());  // at most submap_size: addKeyframe(), setSettings()
   last_pose_ = step.pose;
 
   std::ostringstream os;

@@ -75,13 +75,9 @@ PointArray scanInBody(const Scene& scene, const ScannerModel& model, const Eigen
                       std::mt19937_64& rng) {
   Eigen::Isometry3d mount = Eigen::Isometry3d::Identity();
   mount.linear() = sensorToBodyRotation();
-  PointArray p = scan(scene, model, body * mount, rng);
-  const Eigen::Matrix3f R = mount.linear().cast<float>();
-  for (std::size_t i = 0; i < p.size(); ++i) {
-    const Eigen::Vector3f q = R * p.point(i);
-    p.x[i] = q.x(), p.y[i] = q.y(), p.z[i] = q.z();
-  }
-  return p;
+  PointArray in_body;
+  appendTransformed(in_body, scan(scene, model, body * mount, rng), mount);
+  return in_body;
 }
 
 }  // namespace cube_scan_matcher::sim

@@ -6,6 +6,7 @@
 #include <vector>
 
 #include <Eigen/Core>
+#include <Eigen/Geometry>
 
 namespace cube_scan_matcher {
 
@@ -36,5 +37,16 @@ struct PointArray {
     return none;
   }
 };
+
+/// Appends T * p for every point p of `in` to `out` (rotation and translation in float).
+inline void appendTransformed(PointArray& out, const PointArray& in, const Eigen::Isometry3d& T) {
+  const Eigen::Matrix3f R = T.linear().cast<float>();
+  const Eigen::Vector3f t = T.translation().cast<float>();
+  out.reserve(out.size() + in.size());
+  for (std::size_t i = 0; i < in.size(); ++i) {
+    const Eigen::Vector3f q = R * in.point(i) + t;
+    out.push_back(q.x(), q.y(), q.z());
+  }
+}
 
 }  // namespace cube_scan_matcher

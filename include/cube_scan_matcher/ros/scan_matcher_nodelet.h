@@ -92,9 +92,10 @@ class ScanMatcherNodelet : public nodelet::Nodelet {
   std::optional<Eigen::Isometry3d> map_odom_;
   ros::Timer tf_timer_;
 
-  // Variances [m^2], [rad^2] of the published pose: they grow along the chain (a random walk of
-  // the increments' errors) and restart at the first scan of a chain.
-  double keyframe_var_t_ = 0.0, keyframe_var_r_ = 0.0;  // [m^2], [rad^2] of the keyframe pose
+  // Variances [m^2], [rad^2] of the current keyframe's pose: a scan's published variance is
+  // these plus one increment's; they grow from keyframe to keyframe (a random walk of the
+  // increments' errors) and restart at the first scan of a chain.
+  double keyframe_var_t_ = 0.0, keyframe_var_r_ = 0.0;
   std::optional<std::pair<double, double>> start_var_;  // from ~set_pose, for the next first scan
 
   nav_msgs::Path path_;
