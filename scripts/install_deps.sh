@@ -17,7 +17,7 @@ PKGS=(
   python3-rospy python3-nav-msgs python3-sensor-msgs python3-geometry-msgs python3-std-srvs
   python3-tf2-ros python3-diagnostic-msgs python3-numpy
   rviz xvfb xauth imagemagick procps
-  clang-14 libfuzzer-14-dev
+  clang-14 libfuzzer-14-dev libopen3d-dev
 )
 missing=()
 for p in "${PKGS[@]}"; do

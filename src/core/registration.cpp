@@ -8,6 +8,7 @@
 #include <stdexcept>
 
 #include "cube_scan_matcher/core/coincidence_objective.h"
+#include "cube_scan_matcher/core/dense_sampling.h"
 #include "cube_scan_matcher/core/multi_scale_objective.h"
 #include "cube_scan_matcher/core/voxel_collapse.h"
 #include "require_in_range.h"
@@ -21,6 +22,7 @@ RegistrationSettings RegistrationSettings::paper(double cube_edge) {
   s.search.starts = 1;
   s.search.threads = 1;
   s.collapse_fraction = 0.0;
+  s.dense_points = 0;
   s.refine.enabled = false;
   return s;
 }
@@ -31,6 +33,7 @@ void validate(const RegistrationSettings& s) {
   validate(s.refine);
   validate(s.search);
   requireInRange("collapse_fraction", s.collapse_fraction, 0.0, 1.0);
+  requireInRange("dense_points", s.dense_points, 0, 1000);
 }
 
 std::string toString(RegistrationStatus status) {
@@ -50,9 +53,10 @@ struct CubeRegistration::ScanPoints {
   ScanPoints() = default;
   ScanPoints(const ScanPoints&) = delete;
   ScanPoints& operator=(const ScanPoints&) = delete;
-  const PointArray* coarse = nullptr;
-  const PointArray* fine = nullptr;
-  PointArray coarse_storage, fine_storage;
+  const PointArray* coarse = nullptr;  ///< the coarse search's points (dense part, collapsed)
+  const PointArray* full = nullptr;    ///< all points collapsed as for the coarse search: J
+  const PointArray* fine = nullptr;    ///< the refine's points (all points, collapsed)
+  PointArray dense_storage, coarse_storage, full_storage, fine_storage;
 };
 
 CubeRegistration::CubeRegistration(const RegistrationSettings& settings)
@@ -80,6 +84,19 @@ const CubeGrid& CubeRegistration::grid() const {
   return reference_ ? reference_->coarse : empty;
 }
 
+namespace {
+
+/// Beyond the paper: the points of `cloud` on densely sampled surfaces (in `storage`), or
+/// `cloud` itself when the filter is off or would keep nothing.
+const PointArray* densePart(const PointArray& cloud, const RegistrationSettings& s, double edge,
+                            PointArray& storage) {
+  if (s.dense_points <= 1 || cloud.empty()) return &cloud;
+  storage = keepDenselySampled(cloud, edge, s.dense_points);
+  return storage.empty() ? &cloud : &storage;
+}
+
+}  // namespace
+
 void CubeRegistration::setReference(const PointArray& reference) {
   // All grids are built (outside the lock, so a running align() is not held up) before any is
   // replaced, so an error keeps the previous reference.
@@ -88,8 +105,8 @@ void CubeRegistration::setReference(const PointArray& reference) {
     std::lock_guard<std::mutex> lock(*mutex_);
     s = settings_;
   }
-  auto next = std::make_unique<ReferenceGrids>(
-      buildReferenceGrids(reference, s.grid, s.refine.enabled ? s.refine.grids : 0,
+  auto next = std::make_unique<ReferenceGrids>(buildReferenceGrids(
+      reference, s.grid, s.refine.enabled ? s.refine.grids : 0,
                           s.refine.edge_fraction, s.search.threads));
   std::lock_guard<std::mutex> lock(*mutex_);
   // The working copies move to the new grids while the old ones are still alive.
@@ -119,9 +136,12 @@ const PointArray* collapsed(const PointArray& scan, double fraction, double edge
 
 void CubeRegistration::prepareScan(const PointArray& scan, ScanPoints& p) const {
   const double edge = reference_->coarse.edge();
-  p.coarse = collapsed(scan, settings_.collapse_fraction, edge, p.coarse_storage);
+  const PointArray& dense = *densePart(scan, settings_, edge, p.dense_storage);
+  p.coarse = collapsed(dense, settings_.collapse_fraction, edge, p.coarse_storage);
+  p.full = &dense == &scan ? p.coarse
+                           : collapsed(scan, settings_.collapse_fraction, edge, p.full_storage);
   p.fine = settings_.refine.collapse_fraction == settings_.collapse_fraction
-               ? p.coarse
+               ? p.full
                : collapsed(scan, settings_.refine.collapse_fraction, edge, p.fine_storage);
 }
 
@@ -179,9 +199,9 @@ void CubeRegistration::refineStage(const ScanPoints& points, const std::vector<P
   res.pose = r.pose;
   res.evaluations += r.evaluations;
   res.evaluations_refine = r.evaluations;
-  // J on the E grid at the result, on the coarse stage's points.
+  // J on the E grid at the result, on all points collapsed as for the coarse stage.
   CoincidenceObjective& objective = workspaces_[0]->coarse;
-  objective.setScan(*points.coarse);
+  objective.setScan(*points.full);
   res.J = objective(res.pose);
 }
 

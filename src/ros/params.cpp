@@ -38,6 +38,7 @@ void configToSettings(const ScanMatcherConfig& c, OnlineMatcherSettings& m) {
   r.search.starts = c.starts;
   r.search.threads = c.threads;
   r.collapse_fraction = c.collapse_fraction;
+  r.dense_points = c.dense_points;
   r.refine.enabled = c.refine;
   r.refine.edge_fraction = c.refine_edge_fraction;
   r.refine.grids = c.refine_grids;
@@ -109,6 +110,7 @@ ScanMatcherConfig toConfig(const NodeParams& p) {
   c.starts = r.search.starts;
   c.threads = r.search.threads;
   c.collapse_fraction = r.collapse_fraction;
+  c.dense_points = r.dense_points;
   c.refine = r.refine.enabled;
   c.refine_edge_fraction = r.refine.edge_fraction;
   c.refine_grids = r.refine.grids;

@@ -23,6 +23,38 @@ Eigen::Isometry3d randomTransform(std::mt19937_64& rng, double t, double a_deg) 
   return e;
 }
 
+Eigen::Isometry3d paperTable1Motion(SceneType type) {
+  struct Row {
+    double x0, y0, z0, alpha, beta, gamma;  // [m], [deg]: Table 1, the paper's frame
+  };
+  Row r{};
+  switch (type) {
+    case SceneType::Hall: r = {-2.570, 3.144, -0.029, -20.858, 1.651, 5.999}; break;
+    case SceneType::Urban: r = {0.406, 3.662, 0.053, 27.126, 5.282, -6.127}; break;
+    case SceneType::Park: r = {2.541, 4.696, 0.133, -44.106, -0.717, 6.294}; break;
+    case SceneType::Natural: r = {0.732, 2.516, -0.049, -1.675, -14.666, -2.258}; break;
+  }
+  Eigen::Isometry3d paper = Eigen::Isometry3d::Identity();
+  paper.translation() = Eigen::Vector3d(r.x0, r.y0, r.z0);
+  paper.linear() = (Eigen::AngleAxisd(deg2rad(r.alpha), Eigen::Vector3d::UnitZ()) *
+                    Eigen::AngleAxisd(deg2rad(r.beta), Eigen::Vector3d::UnitY()) *
+                    Eigen::AngleAxisd(deg2rad(r.gamma), Eigen::Vector3d::UnitX()))
+                       .toRotationMatrix();
+  Eigen::Isometry3d m = Eigen::Isometry3d::Identity();  // paper frame -> simulator frame
+  m.linear() = Eigen::AngleAxisd(-M_PI / 2, Eigen::Vector3d::UnitZ()).toRotationMatrix();
+  return m * paper * m.inverse();
+}
+
+Eigen::Isometry3d randomPairMotion(std::mt19937_64& rng) {
+  const double travel = std::uniform_real_distribution<double>(1.0, 5.0)(rng);
+  const double yaw = deg2rad(uniform(rng, 45.0));
+  Eigen::Isometry3d t = Eigen::Isometry3d::Identity();
+  t.translation() = Eigen::Vector3d(travel * std::cos(yaw / 2), travel * std::sin(yaw / 2),
+                                    uniform(rng, 0.1));
+  t.linear() = rotationFromRpy(deg2rad(uniform(rng, 2.0)), deg2rad(uniform(rng, 2.0)), yaw);
+  return t;
+}
+
 RobotMotion::RobotMotion(const Scene& scene, const MotionSettings& settings, std::uint64_t seed)
     : scene_(scene), s_(settings), rng_(seed) {
   heading_ = deg2rad(uniform(rng_, s_.heading_max_deg));

@@ -20,6 +20,7 @@
 #include "cube_scan_matcher/core/registration.h"
 #include "cube_scan_matcher/io/cloud_io.h"
 #include "cube_scan_matcher/io/dataset.h"
+#include "open3d_peers.h"
 #include "peer_methods.h"
 #include "settings_cli.h"
 
@@ -31,6 +32,8 @@ namespace {
 
 const std::vector<std::string> kAllMethods = {"cubes",   "cubes-paper", "icp-raw",   "icp-voxel",
                                               "ndt-raw", "ndt-voxel",   "gicp-voxel"};
+/// Open3D peers: named explicitly (not in 'all', whose figures BENCHMARK.md keeps comparable).
+const std::vector<std::string> kOpen3dMethods = {"o3d-p2pl-voxel", "o3d-gicp-voxel"};
 
 void usage(std::ostream& os) {
   os << "usage: benchmark DATASET_DIR [options]\n"
@@ -40,7 +43,9 @@ void usage(std::ostream& os) {
         "                        (default big)\n"
         "  --methods LIST        comma list of: cubes (package defaults), cubes-paper (the\n"
         "                        paper's fixed mode), icp-raw, icp-voxel, ndt-raw, ndt-voxel,\n"
-        "                        gicp-voxel; or 'all' (default all)\n"
+        "                        gicp-voxel; or 'all' (default all); also o3d-p2pl-voxel,\n"
+        "                        o3d-gicp-voxel (Open3D point-to-plane ICP and GICP, when\n"
+        "                        built with libopen3d-dev)\n"
         "  --edges LIST          cube edges E [m] for the cube methods (default 0.5)\n"
         "  --voxel L             voxel leaf of the *-voxel peer copies [m] (default 0.2)\n"
         "  --trial-seed N        seed of the initial-guess errors (default 1)\n"
@@ -122,7 +127,11 @@ int main(int argc, char** argv) {
         const std::string m = next();
         methods = m == "all" ? kAllMethods : splitList(m);
         for (const auto& name : methods) {
-          if (std::find(kAllMethods.begin(), kAllMethods.end(), name) == kAllMethods.end())
+          const bool o3d =
+              std::find(kOpen3dMethods.begin(), kOpen3dMethods.end(), name) != kOpen3dMethods.end();
+          if (o3d && !open3dAvailable())
+            throw std::invalid_argument("--methods " + name + ": this build has no Open3D");
+          if (!o3d && std::find(kAllMethods.begin(), kAllMethods.end(), name) == kAllMethods.end())
             throw std::invalid_argument("--methods: unknown method '" + name + "'");
         }
       } else if (a == "--edges") {
@@ -212,6 +221,8 @@ int main(int argc, char** argv) {
       if (m == "ndt-raw") peer(m, runNdt, false);
       if (m == "ndt-voxel") peer(m, runNdt, true);
       if (m == "gicp-voxel") peer(m, runGicp, true);
+      if (m == "o3d-p2pl-voxel") peer(m, runOpen3dPointToPlane, true);
+      if (m == "o3d-gicp-voxel") peer(m, runOpen3dGicp, true);
     }
 
     const std::vector<PairEntry> pairs = readPairs(dir);

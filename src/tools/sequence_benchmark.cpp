@@ -22,6 +22,7 @@
 #include "cube_scan_matcher/sim/motion.h"
 #include "cube_scan_matcher/sim/sequence_motion.h"
 #include "cube_scan_matcher/sim/tilting_scanner.h"
+#include "open3d_peers.h"
 #include "peer_methods.h"
 #include "settings_cli.h"
 
@@ -45,7 +46,9 @@ void usage(std::ostream& os) {
         "  --methods LIST        comma list of cubes (package defaults: keyframes and a\n"
         "                        submap), cubes-s2s (every scan a keyframe, no submap: scan\n"
         "                        to scan), cubes-submap (--submap keyframes merged),\n"
-        "                        gicp, ndt, icp (PCL on --voxel copies, scan to scan)\n"
+        "                        gicp, ndt, icp (PCL on --voxel copies, scan to scan),\n"
+        "                        o3d-p2pl, o3d-gicp (Open3D point-to-plane ICP and GICP on\n"
+        "                        the same copies, when built with libopen3d-dev)\n"
         "                        (default cubes,cubes-s2s,gicp,ndt)\n"
         "  --submap K            keyframes merged in cubes-submap (default 3)\n"
         "  --keyframe-distance M, --keyframe-angle DEG   keyframe thresholds of the cube methods\n"
@@ -231,6 +234,11 @@ int main(int argc, char** argv) {
       } else if (m == "gicp") table.push_back(peerMethod(m, runGicp, voxel, cv, matcher_settings.gate));
       else if (m == "ndt") table.push_back(peerMethod(m, runNdt, voxel, cv, matcher_settings.gate));
       else if (m == "icp") table.push_back(peerMethod(m, runIcp, voxel, cv, matcher_settings.gate));
+      else if (m == "o3d-p2pl" || m == "o3d-gicp") {
+        if (!open3dAvailable()) throw std::invalid_argument(m + ": this build has no Open3D");
+        table.push_back(peerMethod(m, m == "o3d-p2pl" ? runOpen3dPointToPlane : runOpen3dGicp,
+                                   voxel, cv, matcher_settings.gate));
+      }
       else throw std::invalid_argument("unknown method: " + m);
     }
 

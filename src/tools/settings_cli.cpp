@@ -34,6 +34,8 @@ std::string algorithmOptionsHelp() {
          "                        (default " + num(d.refine.coarse_weight) + "; 0 = fine grids only)\n"
          "  --refine-candidates K refine the K best distinct coarse results, keep the best\n"
          "                        (default " + std::to_string(d.refine.candidates) + ")\n"
+         "  --dense-points N      the coarse search uses only scan points whose E-cube holds\n"
+         "                        >= N scan points; 0 = all (default " + num(d.dense_points) + ")\n"
          "  --refine-collapse F   the refine stage evaluates one point per voxel of F*E\n"
          "                        (default " + num(d.refine.collapse_fraction) + ")\n"
          "  --refine-grids K      refine on the sum of J over K fine grids shifted by 1/K cube\n"
@@ -95,6 +97,8 @@ bool parseAlgorithmOption(const std::vector<std::string>& args, std::size_t& i,
     s.search.starts = int(value(1)), used = 2;
   } else if (a == "--threads") {
     s.search.threads = int(value(1)), used = 2;
+  } else if (a == "--dense-points") {
+    s.dense_points = int(value(1)), used = 2;
   } else if (a == "--collapse") {
     s.collapse_fraction = value(1), used = 2;
   } else if (a == "--seed") {

@@ -287,3 +287,42 @@ TEST(Registration, SettingsAreValidated) {
 }
 
 }  // namespace
+
+// The "no motion" maximum (dense_sampling.h): two sweeps 1.5 m apart along the street of a
+// weakly structured world, guesses 0.9 m short of the motion (0.6 m from "no motion"). J on all
+// points peaks where the second sweep is laid onto the first's own sampling pattern; a coarse
+// search on densely sampled cubes only (dense_points = 4) finds the motion. (Measured when
+// written: with dense_points = 0, 7 of these 8 trials land at "no motion", 1.5 m off; with 3,
+// 4 or 6 all 8 within 4.2 cm.)
+TEST(Registration, DenseSamplingFindsTheMotionNotTheSensorsOwnPattern) {
+  for (const sim::SceneType type : {sim::SceneType::Hall, sim::SceneType::Park}) {
+    const sim::Scene scene = sim::Scene::generate(type, 1);
+    const sim::ScannerModel model;
+    std::mt19937_64 rng(3);
+    std::uniform_real_distribution<double> u(-1.0, 1.0);
+    int successes = 0;
+    for (int trial = 0; trial < 4; ++trial) {
+      const double x = 10.0 + 25.0 * trial;
+      Eigen::Isometry3d a = Eigen::Isometry3d::Identity();
+      a.translation() = Eigen::Vector3d(x, 0.0, scene.groundHeight(x, 0.0) + 1.0);
+      Eigen::Isometry3d b = a;
+      b.translation() = Eigen::Vector3d(x + 1.5, 0.0, scene.groundHeight(x + 1.5, 0.0) + 1.0);
+      const Eigen::Isometry3d truth = a.inverse() * b;
+      RegistrationSettings settings;
+      settings.dense_points = 4;
+      CubeRegistration reg(settings);
+      reg.setReference(sim::scanInBody(scene, model, a, rng));
+      const PointArray scan = sim::scanInBody(scene, model, b, rng);
+      Pose6 guess = isometryToPose(truth);
+      guess[0] -= 0.9;
+      guess[1] += 0.2 * u(rng);
+      guess[5] += deg2rad(2.0) * u(rng);
+      const RegistrationResult r = reg.align(scan, guess);
+      const double dt = (r.transform.translation() - truth.translation()).norm();
+      std::printf("[ trial    ] %s x=%.0f: %.3f m off, J %d, J at truth %d\n",
+                  sim::toString(type).c_str(), x, dt, r.J, reg.score(scan, isometryToPose(truth)));
+      successes += dt < 0.10;
+    }
+    EXPECT_EQ(successes, 4) << sim::toString(type);
+  }
+}

@@ -44,6 +44,20 @@ class RobotMotion {
 /// yaw (eq. 2): the odometry error of one increment.
 Eigen::Isometry3d randomTransform(std::mt19937_64& rng, double t, double a_deg);
 
+/// The motion between the two scans of the paper's Table 1 for a scene type (its ground truth
+/// of the indoor, urban, park and natural pairs), as T_first_second in the simulator's body
+/// frame (x forward, y left, z up). The paper's frame has X right, Y forward, Z up, and
+/// [alpha, beta, gamma] about Z, Y, X composed as Rz(alpha) Ry(beta) Rx(gamma) (eq. 2); the
+/// simulator's frame is the paper's turned by -90 deg about Z (M), so the motion is
+/// M T_paper M^T: translation (y0, -x0, z0), yaw alpha, roll beta, pitch -gamma. Hall uses
+/// the indoor row.
+Eigen::Isometry3d paperTable1Motion(SceneType type);
+
+/// A random forward motion between two sweeps, T_first_second: travel uniform in [1, 5] m
+/// along a heading halfway through the yaw change, yaw change uniform within +-45 deg,
+/// height change within +-0.1 m, roll and pitch within +-2 deg.
+Eigen::Isometry3d randomPairMotion(std::mt19937_64& rng);
+
 enum class OdometryError {
   None,   ///< odometry = truth
   Small,  ///< each increment off by uniform +-0.25 m, +-2 deg per parameter (paper "small")

@@ -1,0 +1,39 @@
+#include "cube_scan_matcher/core/dense_sampling.h"
+
+#include <cstdint>
+#include <stdexcept>
+#include <vector>
+
+#include "voxel_key.h"
+
+namespace cube_scan_matcher {
+
+using detail::KeySet;
+
+PointArray keepDenselySampled(const PointArray& points, double edge, int min_points,
+                              DenseSamplingStats* stats) {
+  if (!(edge > 0.0)) throw std::invalid_argument("dense sampling: cube edge must be > 0 m");
+  if (min_points < 1) throw std::invalid_argument("dense sampling: min_points must be >= 1");
+  const float inv = float(1.0 / edge);
+  KeySet set(points.size());
+  std::vector<std::uint32_t> count(set.capacity(), 0);  // points per cube, by slot
+  std::vector<std::uint32_t> slot(points.size());
+  for (std::size_t i = 0; i < points.size(); ++i) {
+    slot[i] = std::uint32_t(set.insert(detail::voxelKey(points.x[i], points.y[i], points.z[i], inv)).first);
+    ++count[slot[i]];
+  }
+  PointArray out;
+  out.reserve(points.size());
+  for (std::size_t i = 0; i < points.size(); ++i) {
+    if (count[slot[i]] >= std::uint32_t(min_points)) out.push_back(points.x[i], points.y[i], points.z[i]);
+  }
+  std::size_t cubes = 0, dense_cubes = 0;
+  for (std::uint32_t c : count) {
+    cubes += c > 0;
+    dense_cubes += c >= std::uint32_t(min_points);
+  }
+  if (stats) *stats = {cubes, dense_cubes, out.size()};
+  return out;
+}
+
+}  // namespace cube_scan_matcher

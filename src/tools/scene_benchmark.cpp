@@ -1,0 +1,233 @@
+// scene_benchmark: pairwise registration over many simulated worlds with exact truth (issue 12).
+// Per trial: a seeded world of a scene type, a start pose on its street, a motion (the paper's
+// Table 1 motion of that scene type, or a random 1-5 m / +-45 deg motion), two sweeps of the
+// simulated tilting scanner, and registrations from guesses = truth with uniform errors within
+// the "big" (+-1 m, +-8 deg) and "small" (+-0.25 m, +-2 deg) bounds. Reports per scene type,
+// motion and bounds: successes (Es < 0.10 m and Ea < 1 deg), median / p95 / max Es and Ea,
+// median time, and the acceptance gate's verdict on every trial (false accepts: accepted but
+// wrong; false rejects: rejected but right).
+//   scene_benchmark --worlds 20 --trials 10 --csv scenes.csv
+#include <algorithm>
+#include <cstdio>
+#include <fstream>
+#include <iostream>
+#include <map>
+#include <random>
+#include <string>
+#include <tuple>
+#include <vector>
+
+#include "cube_scan_matcher/core/acceptance_gate.h"
+#include "cube_scan_matcher/core/filters.h"
+#include "cube_scan_matcher/core/metrics.h"
+#include "cube_scan_matcher/core/registration.h"
+#include "cube_scan_matcher/sim/motion.h"
+#include "cube_scan_matcher/sim/tilting_scanner.h"
+#include "settings_cli.h"
+
+using namespace cube_scan_matcher;
+using namespace cube_scan_matcher::tools;
+
+namespace {
+
+void usage(std::ostream& os) {
+  os << "usage: scene_benchmark [options]\n"
+        "  --scenes LIST         comma list of hall, urban, park, natural (default all)\n"
+        "  --worlds N            worlds (scene seeds 1..N) per scene type (default 20)\n"
+        "  --trials N            start poses per world and motion (default 10)\n"
+        "  --motions LIST        table1 (the paper's Table 1 motion of the scene type),\n"
+        "                        random (1-5 m, +-45 deg yaw) (default table1,random)\n"
+        "  --initial-errors B    big (+-1 m, +-8 deg), small (+-0.25 m, +-2 deg) or both\n"
+        "                        (default both)\n"
+        "  --seed N              seed of start poses, motions, noise and guesses (default 1)\n"
+        "  --csv FILE            one row per registration (default scenes.csv)\n"
+        "  --check-success P     exit 2 unless every (scene, motion, bounds) group succeeds in\n"
+        "                        >= P %% of its trials (default off)\n"
+        "  --check-false-accepts N  exit 2 if more than N trials in all are accepted by the\n"
+        "                        gate but wrong (default off)\n"
+     << algorithmOptionsHelp();
+}
+
+struct Bounds {
+  std::string name;
+  double t, a_deg;
+};
+
+struct Row {
+  std::string scene, motion, bounds;
+  int world = 0, trial = 0;
+  double es = 0, ea = 0, time = 0;
+  int J = 0, J_guess = 0, J_truth = 0;
+  GateReason reason = GateReason::Accepted;
+  bool success() const { return es < 0.10 && ea < 1.0; }
+  bool accepted() const { return reason == GateReason::Accepted; }
+};
+
+/// True when `p` is inside (or within `margin` [m] of) a solid of the scene: no place for a
+/// scanner.
+bool insideSolid(const sim::Scene& scene, const Eigen::Vector3d& p, double margin) {
+  for (const sim::Box& b : scene.boxes) {
+    if ((p.array() >= b.lo.array() - margin).all() && (p.array() <= b.hi.array() + margin).all())
+      return true;
+  }
+  for (const sim::Cylinder& c : scene.cylinders) {
+    if (std::hypot(p.x() - c.cx, p.y() - c.cy) < c.r + margin && p.z() > c.z0 - margin &&
+        p.z() < c.z1 + margin)
+      return true;
+  }
+  for (const sim::Sphere& s : scene.spheres) {
+    if ((p - s.c).norm() < s.r + margin) return true;
+  }
+  return false;
+}
+
+/// A start pose on the scene's street (x in [0, 100] m, |y| <= 1 m, heading within +-10 deg,
+/// base 1 m above the ground) whose sensor and the sensor after `motion` are both in free space.
+Eigen::Isometry3d startPose(const sim::Scene& scene, const Eigen::Isometry3d& motion,
+                            std::mt19937_64& rng) {
+  std::uniform_real_distribution<double> ux(0.0, 100.0), uy(-1.0, 1.0), uh(-10.0, 10.0);
+  for (int attempt = 0; attempt < 200; ++attempt) {
+    const double x = ux(rng), y = uy(rng);
+    Eigen::Isometry3d a = Eigen::Isometry3d::Identity();
+    a.linear() = rotationFromRpy(0.0, 0.0, deg2rad(uh(rng)));
+    a.translation() = Eigen::Vector3d(x, y, scene.groundHeight(x, y) + 1.0);
+    const Eigen::Isometry3d b = a * motion;
+    if (!insideSolid(scene, a.translation(), 0.3) && !insideSolid(scene, b.translation(), 0.3))
+      return a;
+  }
+  throw std::runtime_error("no free start pose found for this world and motion");
+}
+
+double median(const std::vector<double>& v) { return quantile(v, 0.5); }
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  std::vector<std::string> args(argv + 1, argv + argc);
+  std::vector<std::string> scenes = {"hall", "urban", "park", "natural"};
+  std::vector<std::string> motions = {"table1", "random"};
+  std::vector<Bounds> bounds = {{"big", 1.0, 8.0}, {"small", 0.25, 2.0}};
+  int worlds = 20, trials = 10;
+  std::uint64_t seed = 1;
+  std::string csv_path = "scenes.csv";
+  double check_success = -1, check_false_accepts = -1;
+  RegistrationSettings settings;
+  RangeFilterSettings filter;
+  try {
+    for (std::size_t i = 0; i < args.size();) {
+      const std::string& a = args[i];
+      if (a == "-h" || a == "--help") return usage(std::cout), 0;
+      if (parseAlgorithmOption(args, i, settings, filter)) continue;
+      if (i + 1 >= args.size()) throw std::invalid_argument(a + ": missing value or unknown option");
+      const std::string v = args[i + 1];
+      if (a == "--scenes") scenes = splitList(v);
+      else if (a == "--worlds") worlds = int(io::parseNumber(a, v));
+      else if (a == "--trials") trials = int(io::parseNumber(a, v));
+      else if (a == "--motions") motions = splitList(v);
+      else if (a == "--initial-errors") {
+        if (v == "big") bounds = {{"big", 1.0, 8.0}};
+        else if (v == "small") bounds = {{"small", 0.25, 2.0}};
+        else if (v == "both") bounds = {{"big", 1.0, 8.0}, {"small", 0.25, 2.0}};
+        else throw std::invalid_argument("--initial-errors: expected big, small or both");
+      } else if (a == "--seed") seed = std::uint64_t(io::parseNumber(a, v));
+      else if (a == "--csv") csv_path = v;
+      else if (a == "--check-success") check_success = io::parseNumber(a, v);
+      else if (a == "--check-false-accepts") check_false_accepts = io::parseNumber(a, v);
+      else throw std::invalid_argument("unknown option or value: " + a + " " + v);
+      i += 2;
+    }
+    if (worlds < 1 || trials < 1) throw std::invalid_argument("--worlds and --trials must be >= 1");
+    for (const std::string& m : motions) {
+      if (m != "table1" && m != "random") throw std::invalid_argument("unknown motion: " + m);
+    }
+    for (const std::string& s : scenes) sim::sceneTypeFromString(s);  // throws on a bad name
+    validate(settings);
+    validate(filter);
+
+    std::ofstream csv(csv_path);
+    if (!csv) throw std::runtime_error(csv_path + ": cannot write");
+    csv << "scene,world,trial,motion,bounds,Es_m,Ea_deg,time_s,J,J_guess,J_truth,gate,success\n";
+    CubeRegistration reg(settings);
+    const GateSettings gate_settings;
+    const sim::ScannerModel model;
+    std::vector<Row> rows;
+    for (const std::string& scene_name : scenes) {
+      const sim::SceneType type = sim::sceneTypeFromString(scene_name);
+      for (int w = 1; w <= worlds; ++w) {
+        const sim::Scene scene = sim::Scene::generate(type, std::uint64_t(w));
+        std::mt19937_64 rng(seed * 1000003ULL + std::uint64_t(w) * 7919ULL + std::uint64_t(type));
+        for (const std::string& motion_name : motions) {
+          for (int t = 0; t < trials; ++t) {
+            const Eigen::Isometry3d motion =
+                motion_name == "table1" ? sim::paperTable1Motion(type) : sim::randomPairMotion(rng);
+            const Eigen::Isometry3d a = startPose(scene, motion, rng), b = a * motion;
+            // The reference is the first sweep, the scan the second: truth = T_a^-1 T_b.
+            reg.setReference(filterPoints(sim::scanInBody(scene, model, a, rng), filter));
+            const PointArray scan = filterPoints(sim::scanInBody(scene, model, b, rng), filter);
+            const int j_truth = reg.score(scan, isometryToPose(motion));
+            for (const Bounds& bd : bounds) {
+              const Pose6 guess = isometryToPose(motion * sim::randomTransform(rng, bd.t, bd.a_deg));
+              const RegistrationResult r = reg.align(scan, guess);
+              const PoseError e = poseError(r.transform, motion);
+              Row row{scene_name, motion_name, bd.name, w, t, e.es_m, e.ea_deg, r.time_s,
+                      r.J, r.J_guess, j_truth,
+                      r.ok() ? gate(r, guess, gate_settings) : GateReason::RegistrationFailed};
+              csv << row.scene << ',' << w << ',' << t << ',' << row.motion << ',' << row.bounds
+                  << ',' << row.es << ',' << row.ea << ',' << row.time << ',' << row.J << ','
+                  << row.J_guess << ',' << row.J_truth << ',' << toString(row.reason) << ','
+                  << int(row.success()) << '\n';
+              rows.push_back(row);
+            }
+          }
+        }
+        std::fprintf(stderr, "%s: world %d of %d\n", scene_name.c_str(), w, worlds);
+      }
+    }
+
+    // Per (scene, motion, bounds) group.
+    std::printf("%-8s %-7s %-6s %9s %22s %22s %9s %5s %5s %5s\n", "scene", "motion", "bounds",
+                "success", "Es med|p95|max [m]", "Ea med|p95|max [deg]", "median s", "acc",
+                "FA", "FR");
+    std::map<std::tuple<std::string, std::string, std::string>, std::vector<const Row*>> groups;
+    for (const Row& r : rows) groups[{r.scene, r.motion, r.bounds}].push_back(&r);
+    std::vector<std::string> failures;
+    int false_accepts = 0;
+    for (const auto& [key, group] : groups) {
+      std::vector<double> es, ea, time;
+      int ok = 0, acc = 0, fa = 0, fr = 0;
+      for (const Row* r : group) {
+        es.push_back(r->es), ea.push_back(r->ea), time.push_back(r->time);
+        ok += r->success();
+        acc += r->accepted();
+        fa += r->accepted() && !r->success();
+        fr += !r->accepted() && r->success();
+      }
+      false_accepts += fa;
+      const double pct = 100.0 * ok / double(group.size());
+      std::printf("%-8s %-7s %-6s %4d/%-4zu %6.3f|%6.3f|%7.3f %6.2f|%6.2f|%7.2f %9.3f %5d %5d %5d\n",
+                  std::get<0>(key).c_str(), std::get<1>(key).c_str(), std::get<2>(key).c_str(), ok,
+                  group.size(), median(es), quantile(es, 0.95),
+                  *std::max_element(es.begin(), es.end()), median(ea), quantile(ea, 0.95),
+                  *std::max_element(ea.begin(), ea.end()), median(time), acc, fa, fr);
+      if (check_success >= 0 && pct < check_success) {
+        char b[160];
+        std::snprintf(b, sizeof b, "%s %s %s: %.1f %% successes < %.1f %%", std::get<0>(key).c_str(),
+                      std::get<1>(key).c_str(), std::get<2>(key).c_str(), pct, check_success);
+        failures.push_back(b);
+      }
+    }
+    std::printf("success: Es < 0.10 m and Ea < 1 deg; acc: accepted by the gate (GateSettings "
+                "defaults); FA: accepted but wrong; FR: rejected but right; CSV: %s\n",
+                csv_path.c_str());
+    if (check_false_accepts >= 0 && false_accepts > check_false_accepts) {
+      failures.push_back(std::to_string(false_accepts) + " false accepts > " +
+                         std::to_string(int(check_false_accepts)));
+    }
+    for (const std::string& f : failures) std::fprintf(stderr, "CHECK FAILED %s\n", f.c_str());
+    if (!failures.empty()) return 2;
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "scene_benchmark: %s\n", e.what());
+    return 1;
+  }
+  return 0;
+}
