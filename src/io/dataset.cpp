@@ -81,6 +81,7 @@ std::vector<StampedPose> parseTum(std::istream& in, const std::string& file) {
       throw std::runtime_error(where + "expected 'stamp tx ty tz qx qy qz qw'");
     }
     if (std::abs(norm - 1.0) > 1e-3) throw std::runtime_error(where + "quaternion is not unit");
+    if (!p.pose.matrix().allFinite()) throw std::runtime_error(where + "pose is not finite");
     if (!poses.empty() && !(p.stamp > poses.back().stamp)) {
       throw std::runtime_error(where + "stamps must increase");
     }

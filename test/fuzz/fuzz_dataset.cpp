@@ -1,5 +1,5 @@
-// libFuzzer harness: the dataset (pairs.txt) and pose-line parsers and the number parser on
-// arbitrary text. std::runtime_error and std::invalid_argument are their documented answers.
+// libFuzzer harness: the dataset (pairs.txt), TUM trajectory (poses.tum) and pose-line parsers
+// and the number parser on arbitrary text. std::runtime_error and std::invalid_argument are their documented answers.
 #include <cstddef>
 #include <cstdint>
 #include <sstream>
@@ -15,6 +15,13 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   try {
     std::istringstream in(text);
     parsePairs(in, "pairs.txt", "dir");
+  } catch (const std::runtime_error&) {
+  }
+  try {
+    std::istringstream in(text);
+    for (const StampedPose& p : parseTum(in, "poses.tum")) {
+      if (!p.pose.matrix().allFinite()) __builtin_trap();  // parseTum rejects non-finite lines
+    }
   } catch (const std::runtime_error&) {
   }
   {

@@ -1,0 +1,79 @@
+// objective_profile: J along the driving direction between two sweeps of the simulated tilting
+// scanner taken `--step` m apart, on all scan points and on the densely sampled ones
+// (dense_sampling.h). Shows J's false maximum at "no motion" (BENCHMARK.md).
+//   objective_profile --scene hall --seed 1 --step 1.5
+#include <cstdio>
+#include <iostream>
+#include <random>
+#include <string>
+#include <vector>
+
+#include "cube_scan_matcher/core/dense_sampling.h"
+#include "cube_scan_matcher/core/registration.h"
+#include "cube_scan_matcher/io/cloud_io.h"
+#include "cube_scan_matcher/sim/tilting_scanner.h"
+#include "settings_cli.h"
+
+using namespace cube_scan_matcher;
+
+int main(int argc, char** argv) {
+  std::vector<std::string> args(argv + 1, argv + argc);
+  std::string scene_name = "hall";
+  std::uint64_t seed = 1;
+  double step = 1.5;
+  int dense = 4;
+  std::vector<double> starts = {10, 30, 50, 70, 90};
+  try {
+    for (std::size_t i = 0; i < args.size(); i += 2) {
+      const std::string& a = args[i];
+      if (a == "-h" || a == "--help") {
+        std::cout << "usage: objective_profile [--scene NAME] [--seed N] [--step M] [--x LIST]\n"
+                     "                         [--dense-points N]\n"
+                     "  J (E = 0.5 m, default collapse) of the second sweep laid at x = -0.5..1.5\n"
+                     "  times the step (the truth at 1, 'no motion' at 0), along the street from\n"
+                     "  each start x in LIST (default 10,30,50,70,90), on all points and on the\n"
+                     "  points of E-cubes holding >= N points (default 4)\n";
+        return 0;
+      }
+      if (i + 1 >= args.size()) throw std::invalid_argument(a + ": missing value");
+      const std::string& v = args[i + 1];
+      if (a == "--scene") scene_name = v;
+      else if (a == "--seed") seed = std::uint64_t(io::parseNumber(a, v));
+      else if (a == "--step") step = io::parseNumber(a, v);
+      else if (a == "--dense-points") dense = int(io::parseNumber(a, v));
+      else if (a == "--x") {
+        starts.clear();
+        for (const std::string& x : tools::splitList(v)) starts.push_back(io::parseNumber(a, x));
+      } else throw std::invalid_argument("unknown option: " + a);
+    }
+    const sim::Scene scene = sim::Scene::generate(sim::sceneTypeFromString(scene_name), seed);
+    const sim::ScannerModel model;
+    std::mt19937_64 rng(seed + 4);
+    std::printf("%s seed %llu, step %.2f m; J at x = -0.5..1.5 x step (0.25 x step apart)\n",
+                scene_name.c_str(), static_cast<unsigned long long>(seed), step);
+    for (double x0 : starts) {
+      Eigen::Isometry3d a = Eigen::Isometry3d::Identity(), b = Eigen::Isometry3d::Identity();
+      a.translation() = Eigen::Vector3d(x0, 0.0, scene.groundHeight(x0, 0.0) + 1.0);
+      b.translation() = Eigen::Vector3d(x0 + step, 0.0, scene.groundHeight(x0 + step, 0.0) + 1.0);
+      CubeRegistration reg(RegistrationSettings{});
+      reg.setReference(sim::scanInBody(scene, model, a, rng));
+      const PointArray scan = sim::scanInBody(scene, model, b, rng);
+      const PointArray dense_scan = dense > 1 ? keepDenselySampled(scan, 0.5, dense) : scan;
+      const Pose6 truth = isometryToPose(a.inverse() * b);
+      for (const auto* points : {&scan, &dense_scan}) {
+        std::printf("x0 %5.1f %-6s", x0, points == &scan ? "all" : "dense");
+        for (double f = -0.5; f <= 1.51; f += 0.25) {
+          Pose6 p = truth;
+          p[0] = f * step;
+          std::printf(" %6d%s", reg.score(*points, p), f == 0.0 ? "o" : f == 1.0 ? "*" : " ");
+        }
+        std::printf("\n");
+      }
+    }
+    std::printf("o: no motion, *: the truth\n");
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "objective_profile: %s\n", e.what());
+    return 1;
+  }
+  return 0;
+}
