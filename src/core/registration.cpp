@@ -105,8 +105,8 @@ void CubeRegistration::setReference(const PointArray& reference) {
     std::lock_guard<std::mutex> lock(*mutex_);
     s = settings_;
   }
-  auto next = std::make_unique<ReferenceGrids>(buildReferenceGrids(
-      reference, s.grid, s.refine.enabled ? s.refine.grids : 0,
+  auto next = std::make_unique<ReferenceGrids>(
+      buildReferenceGrids(reference, s.grid, s.refine.enabled ? s.refine.grids : 0,
                           s.refine.edge_fraction, s.search.threads));
   std::lock_guard<std::mutex> lock(*mutex_);
   // The working copies move to the new grids while the old ones are still alive.

@@ -31,8 +31,6 @@ inline std::uint64_t mixKey(std::uint64_t k) {
 /// Open-addressing hash set of packed keys (linear probing), sized for `n` distinct keys.
 class KeySet {
  public:
-  static constexpr std::uint64_t kEmpty = ~std::uint64_t{0};  // no packed key has bit 63 set
-
   explicit KeySet(std::size_t n) {
     while (cap_ < 2 * n) cap_ <<= 1;
     table_.assign(cap_, kEmpty);
@@ -47,11 +45,11 @@ class KeySet {
       }
     }
   }
+  /// Slots of the table: insert() returns one of [0, capacity()).
   std::size_t capacity() const { return cap_; }
-  /// The key in `slot`, or kEmpty.
-  std::uint64_t at(std::size_t slot) const { return table_[slot]; }
 
  private:
+  static constexpr std::uint64_t kEmpty = ~std::uint64_t{0};  // no packed key has bit 63 set
   std::size_t cap_ = 64;
   std::vector<std::uint64_t> table_;
 };

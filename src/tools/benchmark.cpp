@@ -296,7 +296,7 @@ int main(int argc, char** argv) {
             es.push_back(r.es);
             ea.push_back(r.ea);
             tm.push_back(r.time);
-            ok += (r.es < 0.10 && r.ea < 1.0);
+            ok += PoseError{r.es, r.ea}.success();
           }
           const double mt = median(tm);
           const bool is_cube = name.rfind("cubes", 0) == 0;

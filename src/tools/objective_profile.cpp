@@ -10,7 +10,7 @@
 
 #include "cube_scan_matcher/core/dense_sampling.h"
 #include "cube_scan_matcher/core/registration.h"
-#include "cube_scan_matcher/io/cloud_io.h"
+#include "cube_scan_matcher/io/dataset.h"
 #include "cube_scan_matcher/sim/tilting_scanner.h"
 #include "settings_cli.h"
 
@@ -58,7 +58,8 @@ int main(int argc, char** argv) {
       CubeRegistration reg(RegistrationSettings{});
       reg.setReference(sim::scanInBody(scene, model, a, rng));
       const PointArray scan = sim::scanInBody(scene, model, b, rng);
-      const PointArray dense_scan = dense > 1 ? keepDenselySampled(scan, 0.5, dense) : scan;
+      const PointArray dense_scan =
+          dense > 1 ? keepDenselySampled(scan, reg.settings().grid.cube_edge, dense) : scan;
       const Pose6 truth = isometryToPose(a.inverse() * b);
       for (const auto* points : {&scan, &dense_scan}) {
         std::printf("x0 %5.1f %-6s", x0, points == &scan ? "all" : "dense");

@@ -59,7 +59,7 @@ struct Row {
   double es = 0, ea = 0, time = 0;
   int J = 0, J_guess = 0, J_truth = 0;
   GateReason reason = GateReason::Accepted;
-  bool success() const { return es < 0.10 && ea < 1.0; }
+  bool success() const { return PoseError{es, ea}.success(); }
   bool accepted() const { return reason == GateReason::Accepted; }
 };
 

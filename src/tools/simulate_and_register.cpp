@@ -81,7 +81,7 @@ int main(int argc, char** argv) {
       const PoseError eg = poseError(poseToIsometry(guess), truth);
       es.push_back(e.es_m);
       ea.push_back(e.ea_deg);
-      ok += e.es_m < 0.10 && e.ea_deg < 1.0;
+      ok += e.success();
       const int j_truth = reg.score(pts, isometryToPose(truth));
       std::printf("%5d %8zu %10.3f %10.3f %10.3f %10.4f %8.2f %8d %8d\n", k, pts.size(), eg.es_m,
                   e.es_m, e.ea_deg, r.time_s, r.overlap(), r.J, j_truth);

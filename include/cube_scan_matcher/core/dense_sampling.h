@@ -20,7 +20,7 @@ namespace cube_scan_matcher {
 
 struct DenseSamplingStats {
   std::size_t cubes = 0;        ///< cubes of edge `edge` holding points.
-  std::size_t dense_cubes = 0;  ///< of which densely surrounded (kept).
+  std::size_t dense_cubes = 0;  ///< of which holding >= min_points points (kept).
   std::size_t kept = 0;         ///< points kept.
 };
 

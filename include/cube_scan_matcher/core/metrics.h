@@ -13,6 +13,8 @@ struct PoseError {
   double es_m;    ///< Es, eq. (7): Euclidean distance of the translations [m].
   double ea_deg;  ///< Ea, eq. (8): root of the summed squared roll, pitch, yaw differences
                   ///< (each wrapped to (-180, 180]) [deg].
+  /// The benchmarks' success: Es < 0.10 m and Ea < 1 deg.
+  bool success() const { return es_m < 0.10 && ea_deg < 1.0; }
 };
 PoseError poseError(const Eigen::Isometry3d& estimate, const Eigen::Isometry3d& reference);
 
