@@ -24,6 +24,7 @@ RegistrationSettings RegistrationSettings::paper(double cube_edge) {
   s.collapse_fraction = 0.0;
   s.dense_points = 0;
   s.refine.enabled = false;
+  s.polish.enabled = false;
   return s;
 }
 
@@ -32,6 +33,7 @@ void validate(const RegistrationSettings& s) {
   validate(s.gnmm);
   validate(s.refine);
   validate(s.search);
+  validate(s.polish);
   requireInRange("collapse_fraction", s.collapse_fraction, 0.0, 1.0);
   requireInRange("dense_points", s.dense_points, 0, 1000);
 }
@@ -108,6 +110,10 @@ void CubeRegistration::setReference(const PointArray& reference) {
   auto next = std::make_unique<ReferenceGrids>(
       buildReferenceGrids(reference, s.grid, s.refine.enabled ? s.refine.grids : 0,
                           s.refine.edge_fraction, s.search.threads));
+  if (s.polish.enabled) {
+    next->planes = PlaneMap(reference, s.polish.voxel_fraction * s.grid.cube_edge,
+                            s.polish.min_points, s.polish.max_planarity);
+  }
   std::lock_guard<std::mutex> lock(*mutex_);
   // The working copies move to the new grids while the old ones are still alive.
   for (auto& w : workspaces_) w->retarget(*next);
@@ -199,10 +205,20 @@ void CubeRegistration::refineStage(const ScanPoints& points, const std::vector<P
   res.pose = r.pose;
   res.evaluations += r.evaluations;
   res.evaluations_refine = r.evaluations;
-  // J on the E grid at the result, on all points collapsed as for the coarse stage.
-  CoincidenceObjective& objective = workspaces_[0]->coarse;
-  objective.setScan(*points.full);
-  res.J = objective(res.pose);
+}
+
+void CubeRegistration::polishStage(const ScanPoints& points, RegistrationResult& res) const {
+  const PolishResult p = polishOnPlanes(reference_->planes, *points.fine, res.pose,
+                                        settings_.polish);
+  res.polished = p.applied;
+  res.plane_correspondences = p.correspondences;
+  if (!p.applied) return;
+  res.pose = p.pose;
+  res.plane_rms = p.rms;
+  res.covariance = p.covariance;
+  res.degenerate = p.degenerate;
+  res.weak_direction = p.weak_direction;
+  res.weak_ratio = p.weak_ratio;
 }
 
 RegistrationResult CubeRegistration::align(const PointArray& scan, const Pose6& guess) const {
@@ -254,7 +270,21 @@ RegistrationResult CubeRegistration::align(const PointArray& scan, const Pose6& 
     res.time_refine_s = seconds(coarse_end, Clock::now());
   }
 
-  // 4. Finish: no objective keeps a pointer to this call's points.
+  // 4. Polish (not in the paper): point-to-plane Gauss-Newton from the cube result, and the
+  // covariance.
+  if (settings_.polish.enabled && res.J > 0 && reference_->planes.voxels() > 0) {
+    const auto polish_start = Clock::now();
+    polishStage(points, res);
+    res.time_polish_s = seconds(polish_start, Clock::now());
+  }
+  if (res.J > 0 && (rs.enabled || res.polished)) {
+    // J on the E grid at the result, on all points collapsed as for the coarse stage.
+    CoincidenceObjective& objective = workspaces_[0]->coarse;
+    objective.setScan(*points.full);
+    res.J = objective(res.pose);
+  }
+
+  // 5. Finish: no objective keeps a pointer to this call's points.
   releaseScan();
   for (int k = 3; k < 6; ++k) res.pose[k] = wrapAngle(res.pose[k]);
   res.transform = poseToIsometry(res.pose);

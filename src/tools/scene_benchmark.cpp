@@ -59,6 +59,20 @@ struct Row {
   double es = 0, ea = 0, time = 0;
   int J = 0, J_guess = 0, J_truth = 0;
   GateReason reason = GateReason::Accepted;
+  /// Error [x y z m, rotation about x y z rad] (left: R_est R_true^-1) and the result's
+  /// standard deviations in the same coordinates (0 when it has no covariance).
+  Eigen::Matrix<double, 6, 1> error = Eigen::Matrix<double, 6, 1>::Zero();
+  Eigen::Matrix<double, 6, 1> sigma = Eigen::Matrix<double, 6, 1>::Zero();
+  bool degenerate = false;
+  /// The largest |error| / sigma over the six axes (0 without a covariance).
+  double maxZ() const {
+    double z = 0.0;
+    for (int k = 0; k < 6; ++k) {
+      if (sigma(k) > 0.0) z = std::max(z, std::abs(error(k)) / sigma(k));
+    }
+    return z;
+  }
+  bool hasCovariance() const { return sigma.maxCoeff() > 0.0; }
   bool success() const { return PoseError{es, ea}.success(); }
   bool accepted() const { return reason == GateReason::Accepted; }
 };
@@ -146,7 +160,9 @@ int main(int argc, char** argv) {
 
     std::ofstream csv(csv_path);
     if (!csv) throw std::runtime_error(csv_path + ": cannot write");
-    csv << "scene,world,trial,motion,bounds,Es_m,Ea_deg,time_s,J,J_guess,J_truth,gate,success\n";
+    csv << "scene,world,trial,motion,bounds,Es_m,Ea_deg,time_s,J,J_guess,J_truth,gate,success,"
+           "ex_m,ey_m,ez_m,erx_rad,ery_rad,erz_rad,sx_m,sy_m,sz_m,srx_rad,sry_rad,srz_rad,"
+           "degenerate\n";
     CubeRegistration reg(settings);
     const GateSettings gate_settings;
     const sim::ScannerModel model;
@@ -172,10 +188,18 @@ int main(int argc, char** argv) {
               Row row{scene_name, motion_name, bd.name, w, t, e.es_m, e.ea_deg, r.time_s,
                       r.J, r.J_guess, j_truth,
                       r.ok() ? gate(r, guess, gate_settings) : GateReason::RegistrationFailed};
+              row.error.head<3>() = r.transform.translation() - motion.translation();
+              const Eigen::AngleAxisd d(r.transform.linear() * motion.linear().transpose());
+              row.error.tail<3>() = d.angle() * d.axis();
+              row.sigma = r.covariance.diagonal().cwiseMax(0.0).cwiseSqrt();
+              row.degenerate = r.degenerate;
               csv << row.scene << ',' << w << ',' << t << ',' << row.motion << ',' << row.bounds
                   << ',' << row.es << ',' << row.ea << ',' << row.time << ',' << row.J << ','
                   << row.J_guess << ',' << row.J_truth << ',' << toString(row.reason) << ','
-                  << int(row.success()) << '\n';
+                  << int(row.success());
+              for (int k = 0; k < 6; ++k) csv << ',' << row.error(k);
+              for (int k = 0; k < 6; ++k) csv << ',' << row.sigma(k);
+              csv << ',' << int(row.degenerate) << '\n';
               rows.push_back(row);
             }
           }
@@ -185,17 +209,24 @@ int main(int argc, char** argv) {
     }
 
     // Per (scene, motion, bounds) group.
-    std::printf("%-8s %-7s %-6s %9s %22s %22s %9s %5s %5s %5s\n", "scene", "motion", "bounds",
+    std::printf("%-8s %-7s %-6s %9s %22s %22s %9s %5s %5s %5s %6s %14s\n", "scene", "motion", "bounds",
                 "success", "Es med|p95|max [m]", "Ea med|p95|max [deg]", "median s", "acc",
-                "FA", "FR");
+                "FA", "FR", ">3sd", "sd_t|sd_r");
     std::map<std::tuple<std::string, std::string, std::string>, std::vector<const Row*>> groups;
     for (const Row& r : rows) groups[{r.scene, r.motion, r.bounds}].push_back(&r);
     std::vector<std::string> failures;
     int false_accepts = 0;
     for (const auto& [key, group] : groups) {
       std::vector<double> es, ea, time;
-      int ok = 0, acc = 0, fa = 0, fr = 0;
+      std::vector<double> sd_t, sd_r;
+      int ok = 0, acc = 0, fa = 0, fr = 0, with_cov = 0, beyond3 = 0;
       for (const Row* r : group) {
+        if (r->accepted() && r->hasCovariance()) {
+          ++with_cov;
+          beyond3 += r->maxZ() > 3.0;
+          sd_t.push_back(r->sigma.head<3>().norm());
+          sd_r.push_back(rad2deg(r->sigma.tail<3>().norm()));
+        }
         es.push_back(r->es), ea.push_back(r->ea), time.push_back(r->time);
         ok += r->success();
         acc += r->accepted();
@@ -204,11 +235,14 @@ int main(int argc, char** argv) {
       }
       false_accepts += fa;
       const double pct = 100.0 * ok / double(group.size());
-      std::printf("%-8s %-7s %-6s %4d/%-4zu %6.3f|%6.3f|%7.3f %6.2f|%6.2f|%7.2f %9.3f %5d %5d %5d\n",
+      std::printf("%-8s %-7s %-6s %4d/%-4zu %6.3f|%6.3f|%7.3f %6.2f|%6.2f|%7.2f %9.3f %5d %5d %5d "
+                  "%5.1f%% %6.4f|%6.3f\n",
                   std::get<0>(key).c_str(), std::get<1>(key).c_str(), std::get<2>(key).c_str(), ok,
                   group.size(), median(es), quantile(es, 0.95),
                   *std::max_element(es.begin(), es.end()), median(ea), quantile(ea, 0.95),
-                  *std::max_element(ea.begin(), ea.end()), median(time), acc, fa, fr);
+                  *std::max_element(ea.begin(), ea.end()), median(time), acc, fa, fr,
+                  with_cov ? 100.0 * beyond3 / with_cov : 0.0, sd_t.empty() ? 0.0 : median(sd_t),
+                  sd_r.empty() ? 0.0 : median(sd_r));
       if (check_success >= 0 && pct < check_success) {
         char b[160];
         std::snprintf(b, sizeof b, "%s %s %s: %.1f %% successes < %.1f %%", std::get<0>(key).c_str(),
@@ -217,7 +251,9 @@ int main(int argc, char** argv) {
       }
     }
     std::printf("success: Es < 0.10 m and Ea < 1 deg; acc: accepted by the gate (GateSettings "
-                "defaults); FA: accepted but wrong; FR: rejected but right; CSV: %s\n",
+                "defaults); FA: accepted but wrong; FR: rejected but right; >3sd: accepted results with an axis's error beyond 3 predicted "
+                "standard deviations; sd_t|sd_r: median predicted sd [m]|[deg] (norm over axes); "
+                "CSV: %s\n",
                 csv_path.c_str());
     if (check_false_accepts >= 0 && false_accepts > check_false_accepts) {
       failures.push_back(std::to_string(false_accepts) + " false accepts > " +

@@ -36,6 +36,13 @@ std::string algorithmOptionsHelp() {
          "                        (default " + std::to_string(d.refine.candidates) + ")\n"
          "  --dense-points N      the coarse search uses only scan points whose E-cube holds\n"
          "                        >= N scan points; 0 = all (default " + num(d.dense_points) + ")\n"
+         "  --polish V            point-to-plane polish on planes fitted in voxels of V*E (3x3x3\n"
+         "                        blocks), 0 = off (default " + num(d.polish.enabled ? d.polish.voxel_fraction : 0.0) + ")\n"
+         "  --polish-kernel K     Geman-McClure scale of the polish [m] (default " + num(d.polish.kernel) + ")\n"
+         "  --polish-planarity P  a plane's smallest / middle eigenvalue at most P (default " + num(d.polish.max_planarity) + ")\n"
+         "  --polish-min-points N reference points a plane needs (default " + std::to_string(d.polish.min_points) + ")\n"
+         "  --polish-iterations N Gauss-Newton steps of the polish (default " + std::to_string(d.polish.max_iterations) + ")\n"
+         "  --covariance-scale C  the polish's covariance is C x sigma^2 H^-1 (default " + num(d.polish.covariance_scale) + ")\n"
          "  --refine-collapse F   the refine stage evaluates one point per voxel of F*E\n"
          "                        (default " + num(d.refine.collapse_fraction) + ")\n"
          "  --refine-grids K      refine on the sum of J over K fine grids shifted by 1/K cube\n"
@@ -79,6 +86,20 @@ bool parseAlgorithmOption(const std::vector<std::string>& args, std::size_t& i,
     s.refine.enabled = value(1) > 0.0;
     if (s.refine.enabled) s.refine.edge_fraction = value(1);
     used = 2;
+  } else if (a == "--polish") {
+    s.polish.enabled = value(1) > 0.0;
+    if (s.polish.enabled) s.polish.voxel_fraction = value(1);
+    used = 2;
+  } else if (a == "--polish-kernel") {
+    s.polish.kernel = value(1), used = 2;
+  } else if (a == "--polish-planarity") {
+    s.polish.max_planarity = value(1), used = 2;
+  } else if (a == "--polish-min-points") {
+    s.polish.min_points = int(value(1)), used = 2;
+  } else if (a == "--polish-iterations") {
+    s.polish.max_iterations = int(value(1)), used = 2;
+  } else if (a == "--covariance-scale") {
+    s.polish.covariance_scale = value(1), used = 2;
   } else if (a == "--refine-coarse-weight") {
     s.refine.coarse_weight = value(1), used = 2;
   } else if (a == "--refine-candidates") {

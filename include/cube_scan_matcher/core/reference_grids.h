@@ -1,11 +1,12 @@
-// The grids of one reference scan (the E grid of the coarse stage and the refine stage's fine
-// grids) and one thread's working copies of them (GridWorkspace), which outlive a registration.
+// The grids of one reference scan (the E grid of the coarse stage, the refine stage's fine
+// grids and the polish's plane map) and one thread's working copies of them (GridWorkspace), which outlive a registration.
 #pragma once
 
 #include <vector>
 
 #include "cube_scan_matcher/core/coincidence_objective.h"
 #include "cube_scan_matcher/core/cube_grid.h"
+#include "cube_scan_matcher/core/plane_map.h"
 #include "cube_scan_matcher/core/point_array.h"
 
 namespace cube_scan_matcher {
@@ -13,6 +14,7 @@ namespace cube_scan_matcher {
 struct ReferenceGrids {
   CubeGrid coarse;             ///< edge E: the coarse stage (and the refine's coarse term).
   std::vector<CubeGrid> fine;  ///< edge edge_fraction * E, origins shifted by k/grids.
+  PlaneMap planes;             ///< the polish's local planes (empty when the polish is off).
 };
 
 /// Builds the E grid (`grid`) and `fine_grids` fine grids of edge fine_edge_fraction * E with

@@ -13,6 +13,7 @@
 #include "cube_scan_matcher/core/coarse_search.h"
 #include "cube_scan_matcher/core/cube_grid.h"
 #include "cube_scan_matcher/core/gnmm.h"
+#include "cube_scan_matcher/core/plane_polish.h"
 #include "cube_scan_matcher/core/point_array.h"
 #include "cube_scan_matcher/core/pose.h"
 #include "cube_scan_matcher/core/reference_grids.h"
@@ -27,13 +28,16 @@ namespace cube_scan_matcher {
 /// Shipped mode: the coarse stage at E = 0.5 m on the scan collapsed to one point per E/4
 /// voxel, four GNMM starts of 300 iterations (15 vertices, restarts within +-1 m/+-8 deg), two
 /// at a time; the refine stage climbs the sum of J over three E/2 grids plus 3 x J on the E
-/// grid from the two best distinct coarse results. Working copies of grids up to 2^22 cubes use
+/// grid from the two best distinct coarse results; the polish moves the refined pose to the
+/// optimum of the point-to-plane distances to the reference's local planes and gives the
+/// covariance. Working copies of grids up to 2^22 cubes use
 /// a byte per cube.
 struct RegistrationSettings {
   CubeGridSettings grid;  ///< E and the memory caps.
   GnmmSettings gnmm;      ///< population, iterations, restart bounds, seed.
   SearchSettings search;  ///< starts and threads of the coarse stage.
   RefineSettings refine;  ///< the fine stage (off in the paper's mode).
+  PolishSettings polish;  ///< the point-to-plane polish and covariance (off in the paper's mode).
   /// Beyond the paper: before the search, keep one scan point per voxel of edge
   /// collapse_fraction * E. 0 = off, every point is evaluated (paper). In [0, 1].
   double collapse_fraction = 0.25;
@@ -80,6 +84,20 @@ struct RegistrationResult {
   double time_s = 0.0;            ///< wall time of align() [s].
   double time_coarse_s = 0.0;     ///< of which the coarse stage (the GNMM starts) [s].
   double time_refine_s = 0.0;     ///< of which the refine stage [s].
+  double time_polish_s = 0.0;     ///< of which the polish and its covariance [s].
+  /// The polish (plane_polish.h): whether it moved the pose, the scan points near a reference
+  /// plane at the result, their weighted RMS distance [m].
+  bool polished = false;
+  int plane_correspondences = 0;
+  double plane_rms = 0.0;
+  /// Covariance of the pose [x y z, small rotations about the reference frame's x y z]
+  /// [m^2, rad^2] from the point-to-plane problem at the result; zero when the polish did not
+  /// run or found too few planes.
+  Eigen::Matrix<double, 6, 6> covariance = Eigen::Matrix<double, 6, 6>::Zero();
+  /// A direction with little information (a corridor's axis): see PolishResult.
+  bool degenerate = false;
+  Eigen::Matrix<double, 6, 1> weak_direction = Eigen::Matrix<double, 6, 1>::Zero();
+  double weak_ratio = 0.0;
   int evaluations_refine = 0;     ///< of `evaluations`, those of the refine stage.
   std::string message;            ///< human-readable summary or reason of failure.
 
@@ -131,6 +149,7 @@ class CubeRegistration {
                    std::vector<Pose6>& ranked) const;
   void refineStage(const ScanPoints& points, const std::vector<Pose6>& ranked,
                    RegistrationResult& res) const;
+  void polishStage(const ScanPoints& points, RegistrationResult& res) const;
   /// Unbinds every objective from this call's points.
   void releaseScan() const;
 

@@ -1,0 +1,71 @@
+// Beyond the paper: the reference scan as local planes, for the point-to-plane polish
+// (plane_polish.h). The reference points are summed per voxel of edge v (count, sum, sum of
+// outer products: one pass, cheap enough to build with every reference); the plane of a voxel
+// is fitted on first use and cached: its normal from the points of the 3 x 3 x 3 voxels
+// around it (robust to range noise), its offset from the voxel's own points (close to a
+// curved surface).
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <memory>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "cube_scan_matcher/core/point_array.h"
+
+namespace cube_scan_matcher {
+
+namespace detail {
+class KeySet;
+}
+
+/// A plane fitted to reference points: n . (q - mean) is the signed distance of q [m].
+struct LocalPlane {
+  Eigen::Vector3d mean = Eigen::Vector3d::Zero();    ///< centroid of the voxel's points [m]
+  Eigen::Vector3d normal = Eigen::Vector3d::UnitZ();  ///< unit normal
+};
+
+class PlaneMap {
+ public:
+  /// An empty map: planeAt() finds nothing.
+  PlaneMap();
+  /// Sums the finite points of `reference` per voxel of edge `voxel` [m] (> 0). A block's plane
+  /// is valid when it holds at least `min_points` points and is flat: smallest eigenvalue of
+  /// the points' covariance <= max_planarity * the middle one (a line, e.g. one scan line
+  /// across the window, has both alike and is no plane).
+  PlaneMap(const PointArray& reference, double voxel, int min_points, double max_planarity);
+  ~PlaneMap();
+  PlaneMap(PlaneMap&&) noexcept;
+  PlaneMap& operator=(PlaneMap&&) noexcept;
+
+  /// The plane of the voxel holding q, or nullptr (no reference point there, too few, not flat).
+  /// Fits and caches it on first use: not safe to call from two threads at once.
+  const LocalPlane* planeAt(const Eigen::Vector3d& q) const;
+
+  double voxel() const { return voxel_; }
+  /// Occupied voxels (0 for an empty map).
+  std::size_t voxels() const { return stats_.size(); }
+
+ private:
+  struct Stats {
+    double n = 0.0;
+    Eigen::Vector3d sum = Eigen::Vector3d::Zero();
+    Eigen::Matrix3d outer = Eigen::Matrix3d::Zero();  // sum of p p^T
+  };
+  enum class Fit : std::uint8_t { Unknown, Plane, None };
+  void fit(std::size_t index, std::int64_t ix, std::int64_t iy, std::int64_t iz) const;
+
+  double voxel_ = 1.0;
+  float inv_ = 1.0f;
+  int min_points_ = 5;
+  double max_planarity_ = 0.1;
+  std::unique_ptr<detail::KeySet> keys_;
+  std::vector<std::uint32_t> slot_to_index_;  // KeySet slot -> index into stats_
+  std::vector<Stats> stats_;
+  mutable std::vector<Fit> fit_;
+  mutable std::vector<LocalPlane> planes_;
+};
+
+}  // namespace cube_scan_matcher

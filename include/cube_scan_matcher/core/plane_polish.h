@@ -1,0 +1,70 @@
+// Beyond the paper: the point-to-plane polish, the last stage of a registration. The cube
+// stages find the basin (the coincidence count J is a step function: its maximum is a plateau
+// of about a fine cube, so where the result lands on it depends on the start); a few
+// Gauss-Newton steps on the distances of the scan points to the reference's local planes
+// (plane_map.h) then move the pose to the continuous optimum inside that basin. The same
+// least-squares problem gives the result's covariance and its weak directions.
+#pragma once
+
+#include <string>
+
+#include <Eigen/Core>
+
+#include "cube_scan_matcher/core/plane_map.h"
+#include "cube_scan_matcher/core/point_array.h"
+#include "cube_scan_matcher/core/pose.h"
+
+namespace cube_scan_matcher {
+
+struct PolishSettings {
+  bool enabled = true;  ///< off in the paper's mode.
+  /// Voxel of the plane map = voxel_fraction * E; a plane is fitted to the 3 x 3 x 3 voxels
+  /// around a scan point's voxel. In (0, 2].
+  double voxel_fraction = 0.5;
+  int min_points = 6;           ///< reference points a plane needs, in [3, 1000].
+  double max_planarity = 0.1;   ///< smallest / middle eigenvalue of a plane's points, (0, 1].
+  /// Geman-McClure kernel: a residual r [m] weighs (k^2 / (k^2 + r^2))^2; residuals beyond one
+  /// voxel are no correspondence. k in (0, 1] m.
+  double kernel = 0.05;
+  int max_iterations = 15;  ///< Gauss-Newton steps, in [1, 100].
+  /// The polish is discarded (the cube result kept) when it moves the pose more than
+  /// max_shift_m or max_shift_rad from the cube result, or finds fewer than min_correspondences.
+  double max_shift_m = 0.25;
+  double max_shift_rad = 0.03490658503988659;  // 2 deg
+  int min_correspondences = 50;
+  /// Directions whose information is below weak_ratio times the strongest one (in units where
+  /// 1 rad = 1 m at the scan's radius of gyration) are not moved by the polish and are
+  /// reported as weak (degenerate). In (0, 1).
+  double weak_ratio = 0.01;
+  /// The covariance: sigma^2 (H)^-1 from the weighted residuals, times this factor (the
+  /// residuals of neighbouring points are correlated, so the raw least-squares covariance is
+  /// too small; calibrated on the scene benchmark). In [1, 1e6].
+  double covariance_scale = 1.0;
+};
+
+/// Throws std::invalid_argument naming the bad setting (only when enabled).
+void validate(const PolishSettings& settings);
+
+struct PolishResult {
+  bool applied = false;  ///< the polish moved the pose (else the input pose is returned).
+  std::string reason;    ///< why not applied ("" when applied)
+  Pose6 pose = Pose6::Zero();
+  int iterations = 0;
+  int correspondences = 0;  ///< scan points with a plane within one voxel at the result.
+  double rms = 0.0;         ///< weighted RMS point-to-plane distance at the result [m].
+  /// Covariance of [x y z, rotation about the reference frame's x y z] [m^2, rad^2]: small
+  /// rotations applied on the left (R' = exp(dtheta) R, t' = t + dt), as ROS's
+  /// PoseWithCovariance. Zero when no plane was found.
+  Eigen::Matrix<double, 6, 6> covariance = Eigen::Matrix<double, 6, 6>::Zero();
+  bool degenerate = false;  ///< some direction is weak (e.g. along a corridor's axis).
+  /// The weakest direction, unit 6-vector in the same coordinates (rotations scaled by the
+  /// radius of gyration), and its information relative to the strongest one.
+  Eigen::Matrix<double, 6, 1> weak_direction = Eigen::Matrix<double, 6, 1>::Zero();
+  double weak_ratio = 0.0;
+};
+
+/// Polishes `pose` (scan -> reference, eq. 2) on `map` with the points of `scan`.
+PolishResult polishOnPlanes(const PlaneMap& map, const PointArray& scan, const Pose6& pose,
+                            const PolishSettings& settings);
+
+}  // namespace cube_scan_matcher

@@ -1,0 +1,97 @@
+#include "cube_scan_matcher/core/plane_map.h"
+
+#include <cmath>
+#include <stdexcept>
+
+#include <Eigen/Eigenvalues>
+
+#include "voxel_key.h"
+
+namespace cube_scan_matcher {
+
+namespace {
+constexpr std::uint32_t kNoIndex = ~std::uint32_t{0};
+constexpr std::int64_t kMaxIndex = (std::int64_t{1} << 21) - 1;
+}  // namespace
+
+PlaneMap::PlaneMap() = default;
+PlaneMap::~PlaneMap() = default;
+PlaneMap::PlaneMap(PlaneMap&&) noexcept = default;
+PlaneMap& PlaneMap::operator=(PlaneMap&&) noexcept = default;
+
+PlaneMap::PlaneMap(const PointArray& reference, double voxel, int min_points,
+                   double max_planarity)
+    : voxel_(voxel),
+      inv_(float(1.0 / voxel)),
+      min_points_(min_points),
+      max_planarity_(max_planarity) {
+  if (!(voxel > 0.0)) throw std::invalid_argument("plane map voxel must be > 0 m");
+  keys_ = std::make_unique<detail::KeySet>(reference.size());
+  slot_to_index_.assign(keys_->capacity(), kNoIndex);
+  for (std::size_t i = 0; i < reference.size(); ++i) {
+    const float x = reference.x[i], y = reference.y[i], z = reference.z[i];
+    if (!std::isfinite(x) || !std::isfinite(y) || !std::isfinite(z)) continue;
+    const auto [slot, added] = keys_->insert(detail::voxelKey(x, y, z, inv_));
+    if (added) {
+      slot_to_index_[slot] = std::uint32_t(stats_.size());
+      stats_.emplace_back();
+    }
+    Stats& s = stats_[slot_to_index_[slot]];
+    const Eigen::Vector3d p(x, y, z);
+    s.n += 1.0;
+    s.sum += p;
+    s.outer += p * p.transpose();
+  }
+  fit_.assign(stats_.size(), Fit::Unknown);
+  planes_.resize(stats_.size());
+}
+
+void PlaneMap::fit(std::size_t index, std::int64_t ix, std::int64_t iy, std::int64_t iz) const {
+  Stats block;
+  for (std::int64_t dz = -1; dz <= 1; ++dz) {
+    for (std::int64_t dy = -1; dy <= 1; ++dy) {
+      for (std::int64_t dx = -1; dx <= 1; ++dx) {
+        const std::int64_t jx = ix + dx, jy = iy + dy, jz = iz + dz;
+        if (jx < 0 || jy < 0 || jz < 0 || jx > kMaxIndex || jy > kMaxIndex || jz > kMaxIndex) {
+          continue;
+        }
+        const std::size_t slot = keys_->find(detail::packVoxel(jx, jy, jz));
+        if (slot == keys_->capacity()) continue;
+        const Stats& s = stats_[slot_to_index_[slot]];
+        block.n += s.n;
+        block.sum += s.sum;
+        block.outer += s.outer;
+      }
+    }
+  }
+  fit_[index] = Fit::None;
+  if (block.n < double(min_points_)) return;
+  const Eigen::Vector3d mean = block.sum / block.n;
+  const Eigen::Matrix3d cov = block.outer / block.n - mean * mean.transpose();
+  Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig;
+  eig.computeDirect(cov);
+  const Eigen::Vector3d& l = eig.eigenvalues();  // increasing
+  if (!(l(0) <= max_planarity_ * l(1)) || !(l(1) > 0.0)) return;
+  // The offset is the mean of the voxel's own points: on a curved surface (a tree's canopy, a
+  // pillar) the mean of the whole block lies a sagitta inside the surface, and every point
+  // near it would be pulled towards the centre of curvature (a bias along the direction the
+  // objects are seen from); the voxel's own mean is 9 x closer to the surface.
+  const Stats& own = stats_[index];
+  planes_[index].mean = own.sum / own.n;
+  planes_[index].normal = eig.eigenvectors().col(0).normalized();
+  fit_[index] = Fit::Plane;
+}
+
+const LocalPlane* PlaneMap::planeAt(const Eigen::Vector3d& q) const {
+  if (stats_.empty()) return nullptr;
+  const std::int64_t ix = detail::voxelIndex(float(q.x()), inv_);
+  const std::int64_t iy = detail::voxelIndex(float(q.y()), inv_);
+  const std::int64_t iz = detail::voxelIndex(float(q.z()), inv_);
+  const std::size_t slot = keys_->find(detail::packVoxel(ix, iy, iz));
+  if (slot == keys_->capacity()) return nullptr;
+  const std::size_t index = slot_to_index_[slot];
+  if (fit_[index] == Fit::Unknown) fit(index, ix, iy, iz);
+  return fit_[index] == Fit::Plane ? &planes_[index] : nullptr;
+}
+
+}  // namespace cube_scan_matcher

@@ -1,0 +1,171 @@
+#include "cube_scan_matcher/core/plane_polish.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include <Eigen/Eigenvalues>
+#include <Eigen/Geometry>
+
+#include "require_in_range.h"
+
+namespace cube_scan_matcher {
+
+void validate(const PolishSettings& s) {
+  if (!s.enabled) return;
+  requireInRange("polish.voxel_fraction", s.voxel_fraction, 1e-3, 2.0);
+  requireInRange("polish.min_points", s.min_points, 3, 1000);
+  requireInRange("polish.max_planarity", s.max_planarity, 1e-6, 1.0);
+  requireInRange("polish.kernel", s.kernel, 1e-4, 1.0);
+  requireInRange("polish.max_iterations", s.max_iterations, 1, 100);
+  requireInRange("polish.max_shift_m", s.max_shift_m, 1e-4, 10.0);
+  requireInRange("polish.max_shift_rad", s.max_shift_rad, 1e-5, 1.0);
+  requireInRange("polish.min_correspondences", s.min_correspondences, 6, 1000000);
+  requireInRange("polish.weak_ratio", s.weak_ratio, 1e-9, 0.999);
+  requireInRange("polish.covariance_scale", s.covariance_scale, 1.0, 1e6);
+}
+
+namespace {
+
+using Matrix6 = Eigen::Matrix<double, 6, 6>;
+using Vector6 = Eigen::Matrix<double, 6, 1>;
+
+/// The least-squares problem linearised at (R, t): for each scan point p with q = R p + t and
+/// a plane (n, m) within one voxel, residual r = n . (q - m), Jacobian [n, (R p) x n] for the
+/// perturbation t' = t + dt, R' = exp(dtheta) R; Geman-McClure weights.
+struct Linearisation {
+  Matrix6 H = Matrix6::Zero();
+  Vector6 g = Vector6::Zero();
+  double weight = 0.0;     // sum of w
+  double weighted_r2 = 0.0;  // sum of w r^2
+  int count = 0;
+};
+
+Linearisation linearise(const PlaneMap& map, const PointArray& scan, const Eigen::Matrix3d& R,
+                        const Eigen::Vector3d& t, double kernel) {
+  Linearisation L;
+  const double k2 = kernel * kernel;
+  const double max_r = map.voxel();
+  for (std::size_t i = 0; i < scan.size(); ++i) {
+    const Eigen::Vector3d rp = R * scan.point(i).cast<double>();
+    const Eigen::Vector3d q = rp + t;
+    const LocalPlane* plane = map.planeAt(q);
+    if (!plane) continue;
+    const double r = plane->normal.dot(q - plane->mean);
+    if (std::abs(r) > max_r) continue;
+    const double s = k2 / (k2 + r * r);
+    const double w = s * s;
+    Vector6 J;
+    J.head<3>() = plane->normal;
+    J.tail<3>() = rp.cross(plane->normal);
+    L.H.noalias() += w * J * J.transpose();
+    L.g.noalias() += (w * r) * J;
+    L.weight += w;
+    L.weighted_r2 += w * r * r;
+    ++L.count;
+  }
+  return L;
+}
+
+/// Eigen-decomposition of H in units where a rotation of 1 rad moves a point by `rho` metres.
+struct Spectrum {
+  Eigen::SelfAdjointEigenSolver<Matrix6> eig;
+  Vector6 scale;  // x_scaled = x / scale (1 for translation, 1/rho for rotation)
+  double max_eigenvalue = 0.0;
+};
+
+Spectrum spectrum(const Matrix6& H, double rho) {
+  Spectrum s;
+  s.scale << 1, 1, 1, 1.0 / rho, 1.0 / rho, 1.0 / rho;
+  const Matrix6 Hs = s.scale.asDiagonal() * H * s.scale.asDiagonal();
+  s.eig.compute(Hs);
+  s.max_eigenvalue = std::max(s.eig.eigenvalues()(5), 0.0);
+  return s;
+}
+
+/// The Gauss-Newton step H dx = -g restricted to the directions whose information is at least
+/// weak_ratio of the strongest (the others are left where the cube stages put them).
+Vector6 step(const Linearisation& L, const Spectrum& s, double weak_ratio) {
+  const Vector6 gs = s.scale.asDiagonal() * L.g;
+  Vector6 u = Vector6::Zero();
+  for (int k = 0; k < 6; ++k) {
+    const double lambda = s.eig.eigenvalues()(k);
+    if (!(lambda >= weak_ratio * s.max_eigenvalue) || !(lambda > 0.0)) continue;
+    const Vector6 v = s.eig.eigenvectors().col(k);
+    u -= v * (v.dot(gs) / lambda);
+  }
+  return s.scale.asDiagonal() * u;
+}
+
+double rotationAngle(const Eigen::Matrix3d& R) {
+  return Eigen::AngleAxisd(R).angle();
+}
+
+}  // namespace
+
+PolishResult polishOnPlanes(const PlaneMap& map, const PointArray& scan, const Pose6& pose,
+                            const PolishSettings& s) {
+  PolishResult res;
+  res.pose = pose;
+  if (scan.empty() || map.voxels() == 0 || !pose.allFinite()) {
+    res.reason = "no points or no planes";
+    return res;
+  }
+  const Eigen::Isometry3d T0 = poseToIsometry(pose);
+  Eigen::Matrix3d R = T0.linear();
+  Eigen::Vector3d t = T0.translation();
+  // Radius of gyration of the scan about its origin: the lever arm that makes a rotation
+  // comparable with a translation.
+  double sum_r2 = 0.0;
+  for (std::size_t i = 0; i < scan.size(); ++i) sum_r2 += scan.point(i).cast<double>().squaredNorm();
+  const double rho = std::max(1.0, std::sqrt(sum_r2 / double(scan.size())));
+
+  Linearisation L;
+  for (int it = 0; it < s.max_iterations; ++it) {
+    L = linearise(map, scan, R, t, s.kernel);
+    if (L.count < s.min_correspondences) break;
+    const Vector6 dx = step(L, spectrum(L.H, rho), s.weak_ratio);
+    if (!dx.allFinite()) break;
+    t += dx.head<3>();
+    const Eigen::Vector3d w = dx.tail<3>();
+    if (w.norm() > 0.0) R = Eigen::AngleAxisd(w.norm(), w.normalized()).toRotationMatrix() * R;
+    res.iterations = it + 1;
+    if (dx.head<3>().norm() < 1e-5 && w.norm() < 1e-6) break;
+  }
+  L = linearise(map, scan, R, t, s.kernel);
+  res.correspondences = L.count;
+  if (L.count < s.min_correspondences || L.weight <= 6.0) {
+    res.reason = "too few points near a reference plane";
+    return res;
+  }
+  const double shift_m = (t - T0.translation()).norm();
+  const double shift_rad = rotationAngle(R * T0.linear().transpose());
+  if (!(shift_m <= s.max_shift_m) || !(shift_rad <= s.max_shift_rad)) {
+    res.reason = "the polish left the cube result's basin";
+    return res;
+  }
+  Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
+  T.linear() = R;
+  T.translation() = t;
+  res.pose = isometryToPose(T);
+  res.applied = true;
+  res.rms = std::sqrt(L.weighted_r2 / L.weight);
+
+  // Covariance sigma^2 H^-1 (sigma^2 from the weighted residuals), weak directions included
+  // with their (large) variance; eigenvalues are floored so that the inverse stays finite.
+  const Spectrum sp = spectrum(L.H, rho);
+  const double sigma2 = L.weighted_r2 / (L.weight - 6.0);
+  Matrix6 inv_s = Matrix6::Zero();
+  const double floor = std::max(sp.max_eigenvalue * 1e-12, 1e-300);
+  for (int k = 0; k < 6; ++k) {
+    const Vector6 v = sp.eig.eigenvectors().col(k);
+    inv_s.noalias() += v * v.transpose() / std::max(sp.eig.eigenvalues()(k), floor);
+  }
+  res.covariance = s.covariance_scale * sigma2 * sp.scale.asDiagonal() * inv_s *
+                   sp.scale.asDiagonal();
+  res.weak_ratio = sp.max_eigenvalue > 0.0 ? sp.eig.eigenvalues()(0) / sp.max_eigenvalue : 0.0;
+  res.weak_direction = sp.eig.eigenvectors().col(0);
+  res.degenerate = res.weak_ratio < s.weak_ratio;
+  return res;
+}
+
+}  // namespace cube_scan_matcher
