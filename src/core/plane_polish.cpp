@@ -17,6 +17,9 @@ void validate(const PolishSettings& s) {
   requireInRange("polish.max_planarity", s.max_planarity, 1e-6, 1.0);
   requireInRange("polish.kernel", s.kernel, 1e-4, 1.0);
   requireInRange("polish.max_iterations", s.max_iterations, 1, 100);
+  requireInRange("polish.tolerance_m", s.tolerance_m, 0.0, 0.1);
+  requireInRange("polish.tolerance_rad", s.tolerance_rad, 0.0, 0.01);
+  requireInRange("polish.collapse_fraction", s.collapse_fraction, 0.0, 2.0);
   requireInRange("polish.max_shift_m", s.max_shift_m, 1e-4, 10.0);
   requireInRange("polish.max_shift_rad", s.max_shift_rad, 1e-5, 1.0);
   requireInRange("polish.min_correspondences", s.min_correspondences, 6, 1000000);
@@ -40,8 +43,10 @@ struct Linearisation {
   int count = 0;
 };
 
+/// With `near`, also collects the scan points that found a plane (the only ones the later
+/// iterations need to look at: the pose moves by millimetres).
 Linearisation linearise(const PlaneMap& map, const PointArray& scan, const Eigen::Matrix3d& R,
-                        const Eigen::Vector3d& t, double kernel) {
+                        const Eigen::Vector3d& t, double kernel, PointArray* near = nullptr) {
   Linearisation L;
   const double k2 = kernel * kernel;
   const double max_r = map.voxel();
@@ -50,6 +55,7 @@ Linearisation linearise(const PlaneMap& map, const PointArray& scan, const Eigen
     const Eigen::Vector3d q = rp + t;
     const LocalPlane* plane = map.planeAt(q);
     if (!plane) continue;
+    if (near) near->push_back(scan.x[i], scan.y[i], scan.z[i]);
     const double r = plane->normal.dot(q - plane->mean);
     if (std::abs(r) > max_r) continue;
     const double s = k2 / (k2 + r * r);
@@ -57,12 +63,13 @@ Linearisation linearise(const PlaneMap& map, const PointArray& scan, const Eigen
     Vector6 J;
     J.head<3>() = plane->normal;
     J.tail<3>() = rp.cross(plane->normal);
-    L.H.noalias() += w * J * J.transpose();
+    L.H.selfadjointView<Eigen::Upper>().rankUpdate(J, w);
     L.g.noalias() += (w * r) * J;
     L.weight += w;
     L.weighted_r2 += w * r * r;
     ++L.count;
   }
+  L.H.triangularView<Eigen::StrictlyLower>() = L.H.transpose();
   return L;
 }
 
@@ -119,19 +126,34 @@ PolishResult polishOnPlanes(const PlaneMap& map, const PointArray& scan, const P
   for (std::size_t i = 0; i < scan.size(); ++i) sum_r2 += scan.point(i).cast<double>().squaredNorm();
   const double rho = std::max(1.0, std::sqrt(sum_r2 / double(scan.size())));
 
+  // Two rounds: each starts with a pass over every scan point that collects those near a plane,
+  // then iterates on them alone (the pose moves by millimetres). The second round collects
+  // them again at the first round's result, so the final set does not depend on the start.
   Linearisation L;
-  for (int it = 0; it < s.max_iterations; ++it) {
-    L = linearise(map, scan, R, t, s.kernel);
-    if (L.count < s.min_correspondences) break;
-    const Vector6 dx = step(L, spectrum(L.H, rho), s.weak_ratio);
-    if (!dx.allFinite()) break;
-    t += dx.head<3>();
-    const Eigen::Vector3d w = dx.tail<3>();
-    if (w.norm() > 0.0) R = Eigen::AngleAxisd(w.norm(), w.normalized()).toRotationMatrix() * R;
-    res.iterations = it + 1;
-    if (dx.head<3>().norm() < 1e-5 && w.norm() < 1e-6) break;
+  bool converged = false;  // the last step was below the tolerances: L still holds there
+  PointArray near;
+  int it = 0;
+  for (int round = 0; round < 2 && it < s.max_iterations; ++round) {
+    near.clear();
+    converged = false;
+    for (bool collect = true; it < s.max_iterations; collect = false) {
+      L = collect ? linearise(map, scan, R, t, s.kernel, &near)
+                  : linearise(map, near, R, t, s.kernel);
+      if (L.count < s.min_correspondences) break;
+      const Vector6 dx = step(L, spectrum(L.H, rho), s.weak_ratio);
+      if (!dx.allFinite()) break;
+      t += dx.head<3>();
+      const Eigen::Vector3d w = dx.tail<3>();
+      if (w.norm() > 0.0) R = Eigen::AngleAxisd(w.norm(), w.normalized()).toRotationMatrix() * R;
+      res.iterations = ++it;
+      if (dx.head<3>().norm() < s.tolerance_m && w.norm() < s.tolerance_rad) {
+        converged = true;
+        break;
+      }
+    }
+    if (!converged) break;
   }
-  L = linearise(map, scan, R, t, s.kernel);
+  if (!converged) L = linearise(map, near.empty() ? scan : near, R, t, s.kernel);
   res.correspondences = L.count;
   if (L.count < s.min_correspondences || L.weight <= 6.0) {
     res.reason = "too few points near a reference plane";

@@ -7,7 +7,8 @@
 namespace cube_scan_matcher {
 
 ReferenceGrids buildReferenceGrids(const PointArray& reference, const CubeGridSettings& grid,
-                                   int fine_grids, double fine_edge_fraction, int threads) {
+                                   int fine_grids, double fine_edge_fraction, int threads,
+                                   const PlaneMapSettings& planes) {
   // specs[0] is the E grid, the rest are the fine grids.
   std::vector<CubeGridSettings> specs{grid};
   CubeGridSettings gs = grid;
@@ -17,10 +18,17 @@ ReferenceGrids buildReferenceGrids(const PointArray& reference, const CubeGridSe
     specs.push_back(gs);
   }
   std::vector<CubeGrid> grids(specs.size());
-  std::vector<std::exception_ptr> errors(specs.size());
-  runOnThreads(int(specs.size()), threads, [&](int k, int) {
+  // The plane map is the last job, built beside the grids.
+  const int jobs = int(specs.size()) + (planes.enabled ? 1 : 0);
+  std::vector<std::exception_ptr> errors(static_cast<std::size_t>(jobs));
+  PlaneMap plane_map;
+  runOnThreads(jobs, threads, [&](int k, int) {
     try {
-      grids[std::size_t(k)] = CubeGrid::build(reference, specs[std::size_t(k)]);
+      if (k == int(specs.size())) {
+        plane_map = PlaneMap(reference, planes.voxel, planes.min_points, planes.max_planarity);
+      } else {
+        grids[std::size_t(k)] = CubeGrid::build(reference, specs[std::size_t(k)]);
+      }
     } catch (...) {
       errors[std::size_t(k)] = std::current_exception();
     }
@@ -31,6 +39,7 @@ ReferenceGrids buildReferenceGrids(const PointArray& reference, const CubeGridSe
   ReferenceGrids r;
   r.coarse = std::move(grids[0]);
   for (std::size_t k = 1; k < specs.size(); ++k) r.fine.push_back(std::move(grids[k]));
+  r.planes = std::move(plane_map);
   return r;
 }
 

@@ -58,7 +58,8 @@ struct CubeRegistration::ScanPoints {
   const PointArray* coarse = nullptr;  ///< the coarse search's points (dense part, collapsed)
   const PointArray* full = nullptr;    ///< all points collapsed as for the coarse search: J
   const PointArray* fine = nullptr;    ///< the refine's points (all points, collapsed)
-  PointArray dense_storage, coarse_storage, full_storage, fine_storage;
+  const PointArray* polish = nullptr;  ///< the polish's points (all points, collapsed)
+  PointArray dense_storage, coarse_storage, full_storage, fine_storage, polish_storage;
 };
 
 CubeRegistration::CubeRegistration(const RegistrationSettings& settings)
@@ -107,13 +108,14 @@ void CubeRegistration::setReference(const PointArray& reference) {
     std::lock_guard<std::mutex> lock(*mutex_);
     s = settings_;
   }
+  PlaneMapSettings planes;
+  planes.enabled = s.polish.enabled;
+  planes.voxel = s.polish.voxel_fraction * s.grid.cube_edge;
+  planes.min_points = s.polish.min_points;
+  planes.max_planarity = s.polish.max_planarity;
   auto next = std::make_unique<ReferenceGrids>(
       buildReferenceGrids(reference, s.grid, s.refine.enabled ? s.refine.grids : 0,
-                          s.refine.edge_fraction, s.search.threads));
-  if (s.polish.enabled) {
-    next->planes = PlaneMap(reference, s.polish.voxel_fraction * s.grid.cube_edge,
-                            s.polish.min_points, s.polish.max_planarity);
-  }
+                          s.refine.edge_fraction, s.search.threads, planes));
   std::lock_guard<std::mutex> lock(*mutex_);
   // The working copies move to the new grids while the old ones are still alive.
   for (auto& w : workspaces_) w->retarget(*next);
@@ -149,6 +151,14 @@ void CubeRegistration::prepareScan(const PointArray& scan, ScanPoints& p) const 
   p.fine = settings_.refine.collapse_fraction == settings_.collapse_fraction
                ? p.full
                : collapsed(scan, settings_.refine.collapse_fraction, edge, p.fine_storage);
+  if (!settings_.polish.enabled) return;
+  const double pf = settings_.polish.collapse_fraction;
+  // A coarser polish set is collapsed from the refine's (fewer points to pass over).
+  const bool from_fine = pf > settings_.refine.collapse_fraction && settings_.refine.collapse_fraction > 0.0;
+  p.polish = pf == settings_.refine.collapse_fraction ? p.fine
+             : pf == settings_.collapse_fraction      ? p.full
+                                                      : collapsed(from_fine ? *p.fine : scan, pf,
+                                                                  edge, p.polish_storage);
 }
 
 void CubeRegistration::releaseScan() const {
@@ -208,9 +218,10 @@ void CubeRegistration::refineStage(const ScanPoints& points, const std::vector<P
 }
 
 void CubeRegistration::polishStage(const ScanPoints& points, RegistrationResult& res) const {
-  const PolishResult p = polishOnPlanes(reference_->planes, *points.fine, res.pose,
+  const PolishResult p = polishOnPlanes(reference_->planes, *points.polish, res.pose,
                                         settings_.polish);
   res.polished = p.applied;
+  res.polish_iterations = p.iterations;
   res.plane_correspondences = p.correspondences;
   if (!p.applied) return;
   res.pose = p.pose;

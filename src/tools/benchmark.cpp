@@ -32,6 +32,8 @@ namespace {
 
 const std::vector<std::string> kAllMethods = {"cubes",   "cubes-paper", "icp-raw",   "icp-voxel",
                                               "ndt-raw", "ndt-voxel",   "gicp-voxel"};
+/// Named explicitly only: the defaults without the polish (its effect, in the same run).
+const std::vector<std::string> kExtraMethods = {"cubes-nopolish"};
 /// Open3D peers: named explicitly (not in 'all', whose figures BENCHMARK.md keeps comparable).
 const std::vector<std::string> kOpen3dMethods = {"o3d-p2pl-voxel", "o3d-gicp-voxel"};
 
@@ -45,7 +47,9 @@ void usage(std::ostream& os) {
         "                        paper's fixed mode), icp-raw, icp-voxel, ndt-raw, ndt-voxel,\n"
         "                        gicp-voxel; or 'all' (default all); also o3d-p2pl-voxel,\n"
         "                        o3d-gicp-voxel (Open3D point-to-plane ICP and GICP, when\n"
-        "                        built with libopen3d-dev)\n"
+        "                        built with libopen3d-dev); cubes-nopolish (the package\n"
+        "                        defaults without the point-to-plane polish, whatever the\n"
+        "                        cube options given: the baseline of the session before it)\n"
         "  --edges LIST          cube edges E [m] for the cube methods (default 0.5)\n"
         "  --voxel L             voxel leaf of the *-voxel peer copies [m] (default 0.2)\n"
         "  --trial-seed N        seed of the initial-guess errors (default 1)\n"
@@ -70,7 +74,8 @@ struct Row {
   double es, ea, time;
   long evaluations;
   long j, j_ref;
-  double time_coarse = 0.0, time_refine = 0.0;  // cube methods: stage times [s]
+  double time_coarse = 0.0, time_refine = 0.0, time_polish = 0.0;
+  int polish_iterations = 0;  // cube methods: stage times [s]
   Eigen::Isometry3d estimate = Eigen::Isometry3d::Identity();  // the method's T_target_source
 };
 
@@ -131,7 +136,10 @@ int main(int argc, char** argv) {
               std::find(kOpen3dMethods.begin(), kOpen3dMethods.end(), name) != kOpen3dMethods.end();
           if (o3d && !open3dAvailable())
             throw std::invalid_argument("--methods " + name + ": this build has no Open3D");
-          if (!o3d && std::find(kAllMethods.begin(), kAllMethods.end(), name) == kAllMethods.end())
+          const bool extra =
+              std::find(kExtraMethods.begin(), kExtraMethods.end(), name) != kExtraMethods.end();
+          if (!o3d && !extra &&
+              std::find(kAllMethods.begin(), kAllMethods.end(), name) == kAllMethods.end())
             throw std::invalid_argument("--methods: unknown method '" + name + "'");
         }
       } else if (a == "--edges") {
@@ -185,6 +193,8 @@ int main(int argc, char** argv) {
         row.evaluations = r.evaluations;
         row.time_coarse = r.time_coarse_s;
         row.time_refine = r.time_refine_s;
+        row.time_polish = r.time_polish_s;
+        row.polish_iterations = r.polish_iterations;
         row.j = r.J;
         row.j_ref = reg->score(d.src_pts, isometryToPose(d.ref));  // untimed, for comparison
       });
@@ -196,6 +206,11 @@ int main(int argc, char** argv) {
         if (m == "cubes") {
           RegistrationSettings s = cube_settings;
           s.grid.cube_edge = e;
+          addCube(label.str(), s);
+        } else if (m == "cubes-nopolish") {
+          RegistrationSettings s;  // the defaults, not the command line's cube options
+          s.grid.cube_edge = e;
+          s.polish.enabled = false;
           addCube(label.str(), s);
         } else if (m == "cubes-paper") {
           RegistrationSettings s = RegistrationSettings::paper(e);
@@ -229,7 +244,7 @@ int main(int argc, char** argv) {
     std::ofstream csv(csv_path);
     if (!csv) throw std::runtime_error(csv_path + ": cannot write");
     csv << "pair,bounds,method,trial,Es_m,Ea_deg,time_s,evaluations,J,J_ref,time_coarse_s,"
-           "time_refine_s,tx,ty,tz,qx,qy,qz,qw\n";
+           "time_refine_s,time_polish_s,polish_iterations,tx,ty,tz,qx,qy,qz,qw\n";
     std::vector<Row> rows;
     const std::size_t total = pairs.size() * bounds.size() * std::size_t(trials) * table.size();
     std::size_t done = 0;
@@ -269,7 +284,7 @@ int main(int argc, char** argv) {
             csv << row.pair << ',' << row.bounds << ',' << row.method << ',' << row.trial << ','
                 << row.es << ',' << row.ea << ',' << row.time << ',' << row.evaluations << ','
                 << row.j << ',' << row.j_ref << ',' << row.time_coarse << ','
-                << row.time_refine << ',' << poseCsv(row.estimate) << '\n';
+                << row.time_refine << ',' << row.time_polish << ',' << row.polish_iterations << ',' << poseCsv(row.estimate) << '\n';
             ++done;
             const double el = std::chrono::duration<double>(std::chrono::steady_clock::now() -
                                                             bench_start).count();
@@ -282,34 +297,39 @@ int main(int argc, char** argv) {
     }
 
     // Summary: median Es, Ea, time, successes; time ratio to the first cube method.
-    std::printf("\n%-44s %-6s %-22s %9s %9s %10s %8s %10s\n", "pair", "bounds", "method",
-                "med Es[m]", "med Ea[°]", "med t[s]", "success", "t/t_cube");
+    std::printf("\n%-44s %-6s %-22s %9s %9s %10s %8s %10s %16s\n", "pair", "bounds", "method",
+                "med Es[m]", "med Ea[°]", "med t[s]", "success", "t/t_cube", "rep [m]|[°]");
     bool require_ok = true;
     for (const auto& pair : pairs) {
       for (const Bounds& b : bounds) {
         double cube_time = 0.0;
         for (const auto& [name, run] : table) {
           std::vector<double> es, ea, tm;
+          std::vector<Eigen::Isometry3d> estimates;
           int ok = 0;
           for (const Row& r : rows) {
             if (r.pair != pair.name || r.bounds != b.name || r.method != name) continue;
             es.push_back(r.es);
             ea.push_back(r.ea);
             tm.push_back(r.time);
+            estimates.push_back(r.estimate);
             ok += PoseError{r.es, r.ea}.success();
           }
           const double mt = median(tm);
           const bool is_cube = name.rfind("cubes", 0) == 0;
           if (is_cube && cube_time == 0.0) cube_time = mt;
           if (is_cube && require >= 0 && ok < require) require_ok = false;
-          std::printf("%-44s %-6s %-22s %9.4f %9.3f %10.4f %5d/%-2d %10.1f\n", pair.name.c_str(),
-                      b.name.c_str(), name.c_str(), median(es), median(ea), mt, ok, int(es.size()),
-                      cube_time > 0 ? mt / cube_time : 0.0);
+          const Repeatability rep = repeatability(estimates);
+          std::printf("%-44s %-6s %-22s %9.4f %9.3f %10.4f %5d/%-2d %10.1f %7.4f|%7.4f\n",
+                      pair.name.c_str(), b.name.c_str(), name.c_str(), median(es), median(ea), mt,
+                      ok, int(es.size()), cube_time > 0 ? mt / cube_time : 0.0, rep.median_m,
+                      rep.median_deg);
         }
       }
     }
     std::printf("success: Es < 0.10 m and Ea < 1 deg; t/t_cube: median time over the first cube "
-                "method's; CSV: %s\n", csv_path.c_str());
+                "method's; rep: median over trials of the distance to the method's median pose "
+                "(repeatability); CSV: %s\n", csv_path.c_str());
     if (!require_ok) {
       std::fprintf(stderr, "benchmark: a cube method succeeded in fewer than %d of %d trials\n",
                    require, trials);

@@ -64,6 +64,7 @@ struct Row {
   Eigen::Matrix<double, 6, 1> error = Eigen::Matrix<double, 6, 1>::Zero();
   Eigen::Matrix<double, 6, 1> sigma = Eigen::Matrix<double, 6, 1>::Zero();
   bool degenerate = false;
+  double weak_ratio = 0.0;
   /// The largest |error| / sigma over the six axes (0 without a covariance).
   double maxZ() const {
     double z = 0.0;
@@ -162,7 +163,7 @@ int main(int argc, char** argv) {
     if (!csv) throw std::runtime_error(csv_path + ": cannot write");
     csv << "scene,world,trial,motion,bounds,Es_m,Ea_deg,time_s,J,J_guess,J_truth,gate,success,"
            "ex_m,ey_m,ez_m,erx_rad,ery_rad,erz_rad,sx_m,sy_m,sz_m,srx_rad,sry_rad,srz_rad,"
-           "degenerate\n";
+           "degenerate,weak_ratio\n";
     CubeRegistration reg(settings);
     const GateSettings gate_settings;
     const sim::ScannerModel model;
@@ -193,13 +194,14 @@ int main(int argc, char** argv) {
               row.error.tail<3>() = d.angle() * d.axis();
               row.sigma = r.covariance.diagonal().cwiseMax(0.0).cwiseSqrt();
               row.degenerate = r.degenerate;
+              row.weak_ratio = r.weak_ratio;
               csv << row.scene << ',' << w << ',' << t << ',' << row.motion << ',' << row.bounds
                   << ',' << row.es << ',' << row.ea << ',' << row.time << ',' << row.J << ','
                   << row.J_guess << ',' << row.J_truth << ',' << toString(row.reason) << ','
                   << int(row.success());
               for (int k = 0; k < 6; ++k) csv << ',' << row.error(k);
               for (int k = 0; k < 6; ++k) csv << ',' << row.sigma(k);
-              csv << ',' << int(row.degenerate) << '\n';
+              csv << ',' << int(row.degenerate) << ',' << row.weak_ratio << '\n';
               rows.push_back(row);
             }
           }

@@ -18,6 +18,15 @@ struct PoseError {
 };
 PoseError poseError(const Eigen::Isometry3d& estimate, const Eigen::Isometry3d& reference);
 
+/// Repeatability of one pair registered from several starts: the median pose of `estimates`
+/// (component-wise median of the translations and of the rotation vectors relative to the
+/// first estimate) and the median over estimates of each one's distance to it.
+struct Repeatability {
+  double median_m = 0.0;    ///< median translation distance to the median pose [m]
+  double median_deg = 0.0;  ///< median rotation angle to the median pose [deg]
+};
+Repeatability repeatability(const std::vector<Eigen::Isometry3d>& estimates);
+
 /// The q-quantile (q in [0, 1]) of `values` as the element at index floor(q n) of the sorted
 /// values (the last one for q = 1); 0 for no value. Medians and p95s of the tools' reports.
 double quantile(std::vector<double> values, double q);

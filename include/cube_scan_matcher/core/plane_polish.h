@@ -26,7 +26,13 @@ struct PolishSettings {
   /// Geman-McClure kernel: a residual r [m] weighs (k^2 / (k^2 + r^2))^2; residuals beyond one
   /// voxel are no correspondence. k in (0, 1] m.
   double kernel = 0.05;
-  int max_iterations = 15;  ///< Gauss-Newton steps, in [1, 100].
+  int max_iterations = 20;  ///< Gauss-Newton steps in all, in [1, 100].
+  /// Stop when a step moves less than these [m], [rad].
+  double tolerance_m = 5e-4;
+  double tolerance_rad = 1e-4;
+  /// The polish evaluates the scan collapsed to one point per voxel of this * E (the refine
+  /// stage's points when equal to refine.collapse_fraction). 0 = all points. In [0, 2].
+  double collapse_fraction = 0.5;
   /// The polish is discarded (the cube result kept) when it moves the pose more than
   /// max_shift_m or max_shift_rad from the cube result, or finds fewer than min_correspondences.
   double max_shift_m = 0.25;
@@ -35,7 +41,7 @@ struct PolishSettings {
   /// Directions whose information is below weak_ratio times the strongest one (in units where
   /// 1 rad = 1 m at the scan's radius of gyration) are not moved by the polish and are
   /// reported as weak (degenerate). In (0, 1).
-  double weak_ratio = 0.01;
+  double weak_ratio = 1e-4;
   /// The covariance: sigma^2 (H)^-1 from the weighted residuals, times this factor (the
   /// residuals of neighbouring points are correlated, so the raw least-squares covariance is
   /// too small; calibrated on the scene benchmark). In [1, 1e6].

@@ -17,11 +17,20 @@ struct ReferenceGrids {
   PlaneMap planes;             ///< the polish's local planes (empty when the polish is off).
 };
 
-/// Builds the E grid (`grid`) and `fine_grids` fine grids of edge fine_edge_fraction * E with
-/// origins shifted by k/fine_grids of a fine cube, on `threads` threads. Throws the first
-/// CubeGridError (then nothing is returned).
+/// The plane map of a ReferenceGrids (see PlaneMap's constructor); none when not enabled.
+struct PlaneMapSettings {
+  bool enabled = false;
+  double voxel = 0.25;  ///< [m]
+  int min_points = 6;
+  double max_planarity = 0.1;
+};
+
+/// Builds the E grid (`grid`), `fine_grids` fine grids of edge fine_edge_fraction * E with
+/// origins shifted by k/fine_grids of a fine cube and the plane map, on `threads` threads.
+/// Throws the first CubeGridError (then nothing is returned).
 ReferenceGrids buildReferenceGrids(const PointArray& reference, const CubeGridSettings& grid,
-                                   int fine_grids, double fine_edge_fraction, int threads);
+                                   int fine_grids, double fine_edge_fraction, int threads,
+                                   const PlaneMapSettings& planes = PlaneMapSettings{});
 
 /// One thread's objectives: a working copy of every grid of a ReferenceGrids. Moving it to
 /// other grids (retarget) reuses its memory instead of allocating it again.

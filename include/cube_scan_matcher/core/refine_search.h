@@ -33,9 +33,13 @@ struct RefineSettings {
   double collapse_fraction = 0.25;
   /// Compass rotations pivot about the centroid of the scan points (true) or the scan origin.
   bool centroid_pivot = true;
-  /// Compass search: first steps 0.125 m / 1 deg, `levels` = 5 step sizes (halved 4 times,
-  /// last 7.8 mm / 0.0625 deg).
-  CompassSettings compass;
+  /// Compass search: first steps 0.125 m / 1 deg, `levels` = 4 step sizes (halved 3 times,
+  /// last 15.6 mm / 0.125 deg; the polish takes it from there: 5 levels before it).
+  CompassSettings compass = [] {
+    CompassSettings c;
+    c.levels = 4;
+    return c;
+  }();
 };
 
 /// Throws std::invalid_argument naming the bad setting (only when enabled).

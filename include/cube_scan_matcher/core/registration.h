@@ -85,9 +85,10 @@ struct RegistrationResult {
   double time_coarse_s = 0.0;     ///< of which the coarse stage (the GNMM starts) [s].
   double time_refine_s = 0.0;     ///< of which the refine stage [s].
   double time_polish_s = 0.0;     ///< of which the polish and its covariance [s].
-  /// The polish (plane_polish.h): whether it moved the pose, the scan points near a reference
-  /// plane at the result, their weighted RMS distance [m].
+  /// The polish (plane_polish.h): whether it moved the pose, its Gauss-Newton steps, the scan
+  /// points near a reference plane at the result, their weighted RMS distance [m].
   bool polished = false;
+  int polish_iterations = 0;
   int plane_correspondences = 0;
   double plane_rms = 0.0;
   /// Covariance of the pose [x y z, small rotations about the reference frame's x y z]
