@@ -4,6 +4,11 @@
 
 usage: /usr/bin/python3 scripts/plot_scenes.py OUT.png SCENES.csv [LABEL]
        /usr/bin/python3 scripts/plot_scenes.py --table SCENES.csv [SCENES.csv ...]
+       /usr/bin/python3 scripts/plot_scenes.py --calibrate SCENES.csv [SCENES.csv ...]
+
+--calibrate: for the accepted successful registrations with a covariance, the fraction of each
+axis's errors beyond 3 predicted standard deviations, and the smallest factor on the
+covariance (covariance_scale, relative to the run's) that brings every axis to <= 1 %.
 """
 import csv
 import sys
@@ -50,6 +55,38 @@ def table(paths):
                       quantile(t, 0.5), sum(acc), fa, fr))
 
 
+AXES = ("x", "y", "z", "rx", "ry", "rz")
+ERR = ("ex_m", "ey_m", "ez_m", "erx_rad", "ery_rad", "erz_rad")
+SIG = ("sx_m", "sy_m", "sz_m", "srx_rad", "sry_rad", "srz_rad")
+
+
+def calibrate(paths):
+    z = [[] for _ in AXES]  # |error| / sigma per axis
+    for path in paths:
+        with open(path) as fh:
+            for r in csv.DictReader(fh):
+                if r["gate"] != "accepted" or r["success"] != "1":
+                    continue
+                sig = [float(r[k]) for k in SIG]
+                if min(sig) <= 0.0:
+                    continue
+                for k in range(6):
+                    z[k].append(abs(float(r[ERR[k]])) / sig[k])
+    n = len(z[0])
+    if not n:
+        print("no accepted successful registration with a covariance")
+        return
+    print("%d registrations; per axis: %% beyond 3 sd, factor on the variance for <= 1 %%:" % n)
+    worst = 0.0
+    for k, name in enumerate(AXES):
+        beyond = 100.0 * sum(v > 3.0 for v in z[k]) / n
+        # The 99th percentile of |z| must be <= 3 sd: variance factor (q99 / 3)^2.
+        factor = (quantile(z[k], 0.99) / 3.0) ** 2
+        worst = max(worst, factor)
+        print("  %-2s %5.1f %%  x %.1f" % (name, beyond, factor))
+    print("covariance_scale factor for every axis: %.1f (times the run's covariance_scale)" % worst)
+
+
 def plot(out, path, label):
     g = groups(path)
     fig, axes = plt.subplots(2, 1, figsize=(11, 7), sharex=True)
@@ -78,6 +115,8 @@ def plot(out, path, label):
 if __name__ == "__main__":
     if len(sys.argv) >= 3 and sys.argv[1] == "--table":
         table(sys.argv[2:])
+    elif len(sys.argv) >= 3 and sys.argv[1] == "--calibrate":
+        calibrate(sys.argv[2:])
     elif len(sys.argv) in (3, 4):
         plot(sys.argv[1], sys.argv[2], sys.argv[3] if len(sys.argv) == 4 else sys.argv[2])
     else:

@@ -16,6 +16,8 @@ std::string toString(GateReason reason) {
     case GateReason::BadReference: return "bad_reference";
     case GateReason::SkippedNoTf: return "skipped_no_tf";
     case GateReason::BadInput: return "bad_input";
+    case GateReason::Unconfirmed: return "unconfirmed";
+    case GateReason::Degenerate: return "degenerate";
   }
   return "unknown";
 }
@@ -47,6 +49,8 @@ GateReason gate(const RegistrationResult& r, const Pose6& guess, const GateSetti
       Eigen::AngleAxisd(c.linear()).angle() > s.max_correction_rad) {
     return GateReason::CorrectionTooLarge;
   }
+  if (s.require_polish && r.polish_tried && !r.polished) return GateReason::Unconfirmed;
+  if (s.reject_degenerate && r.polished && r.degenerate) return GateReason::Degenerate;
   return GateReason::Accepted;
 }
 

@@ -24,6 +24,7 @@ void validate(const PolishSettings& s) {
   requireInRange("polish.max_shift_rad", s.max_shift_rad, 1e-5, 1.0);
   requireInRange("polish.min_correspondences", s.min_correspondences, 6, 1000000);
   requireInRange("polish.weak_ratio", s.weak_ratio, 1e-9, 0.999);
+  requireInRange("polish.degenerate_ratio", s.degenerate_ratio, 1e-12, 0.999);
   requireInRange("polish.covariance_scale", s.covariance_scale, 1.0, 1e6);
 }
 
@@ -103,6 +104,12 @@ Vector6 step(const Linearisation& L, const Spectrum& s, double weak_ratio) {
   return s.scale.asDiagonal() * u;
 }
 
+double radiusOfGyration(const PointArray& points) {
+  double sum_r2 = 0.0;
+  for (std::size_t i = 0; i < points.size(); ++i) sum_r2 += points.point(i).cast<double>().squaredNorm();
+  return points.empty() ? 1.0 : std::max(1.0, std::sqrt(sum_r2 / double(points.size())));
+}
+
 double rotationAngle(const Eigen::Matrix3d& R) {
   return Eigen::AngleAxisd(R).angle();
 }
@@ -120,11 +127,9 @@ PolishResult polishOnPlanes(const PlaneMap& map, const PointArray& scan, const P
   const Eigen::Isometry3d T0 = poseToIsometry(pose);
   Eigen::Matrix3d R = T0.linear();
   Eigen::Vector3d t = T0.translation();
-  // Radius of gyration of the scan about its origin: the lever arm that makes a rotation
-  // comparable with a translation.
-  double sum_r2 = 0.0;
-  for (std::size_t i = 0; i < scan.size(); ++i) sum_r2 += scan.point(i).cast<double>().squaredNorm();
-  const double rho = std::max(1.0, std::sqrt(sum_r2 / double(scan.size())));
+  // Radius of gyration about the scan's origin of the points near a plane at the start (far
+  // outliers have none): the lever arm that makes a rotation comparable with a translation.
+  double rho = 1.0;
 
   // Two rounds: each starts with a pass over every scan point that collects those near a plane,
   // then iterates on them alone (the pose moves by millimetres). The second round collects
@@ -140,6 +145,7 @@ PolishResult polishOnPlanes(const PlaneMap& map, const PointArray& scan, const P
       L = collect ? linearise(map, scan, R, t, s.kernel, &near)
                   : linearise(map, near, R, t, s.kernel);
       if (L.count < s.min_correspondences) break;
+      if (it == 0) rho = radiusOfGyration(near);
       const Vector6 dx = step(L, spectrum(L.H, rho), s.weak_ratio);
       if (!dx.allFinite()) break;
       t += dx.head<3>();
@@ -186,7 +192,7 @@ PolishResult polishOnPlanes(const PlaneMap& map, const PointArray& scan, const P
                    sp.scale.asDiagonal();
   res.weak_ratio = sp.max_eigenvalue > 0.0 ? sp.eig.eigenvalues()(0) / sp.max_eigenvalue : 0.0;
   res.weak_direction = sp.eig.eigenvectors().col(0);
-  res.degenerate = res.weak_ratio < s.weak_ratio;
+  res.degenerate = res.weak_ratio < s.degenerate_ratio;
   return res;
 }
 

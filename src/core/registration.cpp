@@ -15,6 +15,12 @@
 
 namespace cube_scan_matcher {
 
+namespace {
+/// A start agrees with the result when its coarse pose is this close [m], [rad].
+constexpr double kAgreeTranslation = 0.25;
+constexpr double kAgreeRotation = 0.03490658503988659;  // 2 deg
+}  // namespace
+
 RegistrationSettings RegistrationSettings::paper(double cube_edge) {
   RegistrationSettings s;
   s.grid.cube_edge = cube_edge;
@@ -180,7 +186,8 @@ int CubeRegistration::score(const PointArray& scan, const Pose6& pose) const {
 }
 
 void CubeRegistration::coarseStage(const ScanPoints& points, const Pose6& guess,
-                                   RegistrationResult& res, std::vector<Pose6>& ranked) const {
+                                   RegistrationResult& res, std::vector<Pose6>& ranked,
+                                   std::vector<int>& ranked_J) const {
   std::vector<CoincidenceObjective*> objectives;
   for (auto& w : workspaces_) {
     w->coarse.setScan(*points.coarse);
@@ -194,7 +201,11 @@ void CubeRegistration::coarseStage(const ScanPoints& points, const Pose6& guess,
   res.iterations = c.iterations;
   res.restarts = c.restarts;
   ranked.clear();
-  for (const GnmmResult& r : c.runs) ranked.push_back(r.best);
+  ranked_J.clear();
+  for (const GnmmResult& r : c.runs) {
+    ranked.push_back(r.best);
+    ranked_J.push_back(int(r.best_value));
+  }
 }
 
 void CubeRegistration::refineStage(const ScanPoints& points, const std::vector<Pose6>& ranked,
@@ -220,8 +231,10 @@ void CubeRegistration::refineStage(const ScanPoints& points, const std::vector<P
 void CubeRegistration::polishStage(const ScanPoints& points, RegistrationResult& res) const {
   const PolishResult p = polishOnPlanes(reference_->planes, *points.polish, res.pose,
                                         settings_.polish);
+  res.polish_tried = true;
   res.polished = p.applied;
   res.polish_iterations = p.iterations;
+  res.polish_points = int(points.polish->size());
   res.plane_correspondences = p.correspondences;
   if (!p.applied) return;
   res.pose = p.pose;
@@ -270,8 +283,9 @@ RegistrationResult CubeRegistration::align(const PointArray& scan, const Pose6& 
 
   // 2. Coarse search: GNMM starts on the E grid.
   std::vector<Pose6> ranked;  // the starts' results, by decreasing J
+  std::vector<int> ranked_J;  // and their J
   const auto coarse_start = Clock::now();
-  coarseStage(points, guess, res, ranked);
+  coarseStage(points, guess, res, ranked, ranked_J);
   const auto coarse_end = Clock::now();
   res.time_coarse_s = seconds(coarse_start, coarse_end);
 
@@ -295,7 +309,19 @@ RegistrationResult CubeRegistration::align(const PointArray& scan, const Pose6& 
     res.J = objective(res.pose);
   }
 
-  // 5. Finish: no objective keeps a pointer to this call's points.
+  // 5. Agreement of the starts with the result (ambiguity, for the acceptance gate).
+  for (std::size_t k = 0; k < ranked.size(); ++k) {
+    const Pose6 d = ranked[k] - res.pose;
+    Pose6 a = d;
+    for (int i = 3; i < 6; ++i) a[i] = wrapAngle(d[i]);
+    if (a.head<3>().norm() <= kAgreeTranslation && a.tail<3>().cwiseAbs().maxCoeff() <= kAgreeRotation) {
+      ++res.starts_agreeing;
+    } else {
+      res.J_runner_up = std::max(res.J_runner_up, ranked_J[k]);
+    }
+  }
+
+  // 6. Finish: no objective keeps a pointer to this call's points.
   releaseScan();
   for (int k = 3; k < 6; ++k) res.pose[k] = wrapAngle(res.pose[k]);
   res.transform = poseToIsometry(res.pose);

@@ -23,13 +23,18 @@ namespace {
 
 geometry_msgs::Pose toPoseMsg(const Eigen::Isometry3d& T) { return tf2::toMsg(T); }
 
+/// A covariance in PoseWithCovariance's row-major order [x y z, rotation about x y z].
+boost::array<double, 36> toMsg(const Matrix6d& c) {
+  boost::array<double, 36> m{};
+  for (int i = 0; i < 6; ++i) {
+    for (int j = 0; j < 6; ++j) m[std::size_t(6 * i + j)] = c(i, j);
+  }
+  return m;
+}
+
 /// Diagonal covariance [x y z roll pitch yaw] from standard deviations [m] and [deg].
 boost::array<double, 36> covariance(double sigma_m, double sigma_deg) {
-  boost::array<double, 36> c{};
-  const double a = deg2rad(sigma_deg);
-  for (int i = 0; i < 3; ++i) c[std::size_t(i * 7)] = sigma_m * sigma_m;
-  for (int i = 3; i < 6; ++i) c[std::size_t(i * 7)] = a * a;
-  return c;
+  return toMsg(diagonalCovariance(sigma_m, deg2rad(sigma_deg)));
 }
 
 }  // namespace
@@ -136,8 +141,18 @@ bool ScanMatcherNodelet::setPoseService(SetPose::Request& req, SetPose::Response
     pose.linear() = q.normalized().toRotationMatrix();
     pose.translation() = t;
     matcher_->restartAt(pose);
+    // The request's covariance; a variance it leaves at 0 (unknown) becomes the configured one.
     const auto& c = req.pose.pose.covariance;
-    start_var_ = std::make_pair((c[0] + c[7] + c[14]) / 3.0, (c[21] + c[28] + c[35]) / 3.0);
+    Matrix6d start = Matrix6d::Zero();
+    for (int i = 0; i < 6; ++i) {
+      for (int j = 0; j < 6; ++j) start(i, j) = c[std::size_t(6 * i + j)];
+    }
+    start = 0.5 * (start + start.transpose());
+    const Matrix6d floors = diagonalCovariance(params_.sigma_translation, deg2rad(params_.sigma_rotation));
+    for (int i = 0; i < 6; ++i) {
+      if (!(start(i, i) > 0.0)) start(i, i) = floors(i, i);
+    }
+    start_cov_ = start;
     res.success = true;
     res.message = "the next scan starts a new chain at the given pose";
   }
@@ -153,7 +168,7 @@ void ScanMatcherNodelet::resetState(const std::string& why) {
   last_stamp_.reset();
   dropped_ = rejected_ = tf_failures_ = processed_ = bad_input_ = consecutive_rejections_ = 0;
   latencies_.clear();
-  start_var_.reset();
+  start_cov_.reset();
 }
 
 std::optional<Eigen::Isometry3d> ScanMatcherNodelet::lookup(const std::string& target,
@@ -328,6 +343,16 @@ OnlineStep ScanMatcherNodelet::registerScan(Scan& scan) {
   status.reference_cubes = std::int32_t(r.reference_cubes);
   status.overlap = r.overlap();
   status.points_used = std::uint32_t(r.points_used);
+  status.starts_agreeing = r.starts_agreeing;
+  status.J_runner_up = r.J_runner_up;
+  status.polished = r.polished;
+  status.plane_rms = r.plane_rms;
+  status.degenerate = r.degenerate;
+  status.weak_ratio = r.weak_ratio;
+  for (int k = 0; k < 6; ++k) {
+    status.sigma[std::size_t(k)] = std::sqrt(std::max(0.0, r.covariance(k, k)));
+    status.weak_direction[std::size_t(k)] = r.weak_direction(k);
+  }
   status.evaluations = r.evaluations;
   status.iterations = r.iterations;
   status.restarts = r.restarts;
@@ -356,21 +381,26 @@ OnlineStep ScanMatcherNodelet::registerScan(Scan& scan) {
 
 void ScanMatcherNodelet::publishPose(const Scan& scan, const OnlineStep& step) {
   // Covariance along the chain of keyframes: a scan's pose is its keyframe's plus one
-  // increment, sigma^2 when accepted, (scale * sigma)^2 when propagated by odometry; a new
-  // keyframe keeps its variance. A chain starts at sigma^2 (or the ~set_pose covariance).
-  // Standing still (no new keyframe) the covariance does not grow.
+  // increment. An accepted increment carries the registration's covariance (the polish's,
+  // rotated from the keyframe's axes into the map's) with the configured sigmas as a floor;
+  // one propagated by odometry carries (rejected_sigma_scale * sigma)^2. A new keyframe keeps
+  // its covariance; a chain starts at sigma^2 (or the ~set_pose covariance). Standing still
+  // (no new keyframe) the covariance does not grow. First order: the lever arm of the
+  // keyframe's rotation error is not propagated.
   const double st = params_.sigma_translation, sr = deg2rad(params_.sigma_rotation);
-  double var_t, var_r;
+  Matrix6d cov;
   if (step.reason == GateReason::FirstScan) {
-    var_t = start_var_ && start_var_->first > 0.0 ? start_var_->first : st * st;
-    var_r = start_var_ && start_var_->second > 0.0 ? start_var_->second : sr * sr;
-    start_var_.reset();
+    cov = start_cov_ ? *start_cov_ : diagonalCovariance(st, sr);
+    start_cov_.reset();
+  } else if (step.accepted) {
+    const Eigen::Matrix3d R_map_keyframe = (step.pose * step.increment.inverse()).linear();
+    cov = keyframe_cov_ +
+          rotateCovariance(floorCovariance(step.result.covariance, st, sr), R_map_keyframe);
   } else {
-    const double scale = step.accepted ? 1.0 : params_.rejected_sigma_scale;
-    var_t = keyframe_var_t_ + scale * scale * st * st;
-    var_r = keyframe_var_r_ + scale * scale * sr * sr;
+    const double scale = params_.rejected_sigma_scale;
+    cov = keyframe_cov_ + diagonalCovariance(scale * st, scale * sr);
   }
-  if (step.reference_updated) keyframe_var_t_ = var_t, keyframe_var_r_ = var_r;
+  if (step.reference_updated) keyframe_cov_ = cov;
   std_msgs::Header header;
   header.stamp = scan.msg.header.stamp;
   header.frame_id = params_.map_frame;
@@ -378,7 +408,7 @@ void ScanMatcherNodelet::publishPose(const Scan& scan, const OnlineStep& step) {
   geometry_msgs::PoseWithCovarianceStamped pose;
   pose.header = header;
   pose.pose.pose = toPoseMsg(step.pose);
-  pose.pose.covariance = covariance(std::sqrt(var_t), rad2deg(std::sqrt(var_r)));
+  pose.pose.covariance = toMsg(cov);
   pose_pub_.publish(pose);
 
   nav_msgs::Odometry odometry;

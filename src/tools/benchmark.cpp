@@ -3,6 +3,7 @@
 // seeded trials, the initial guess is the reference pose plus uniform errors within the chosen
 // bounds; the cube method and the PCL peers run in this process on the same guesses.
 #include <algorithm>
+#include <cmath>
 #include <chrono>
 #include <cstdio>
 #include <fstream>
@@ -47,9 +48,9 @@ void usage(std::ostream& os) {
         "                        paper's fixed mode), icp-raw, icp-voxel, ndt-raw, ndt-voxel,\n"
         "                        gicp-voxel; or 'all' (default all); also o3d-p2pl-voxel,\n"
         "                        o3d-gicp-voxel (Open3D point-to-plane ICP and GICP, when\n"
-        "                        built with libopen3d-dev); cubes-nopolish (the package\n"
-        "                        defaults without the point-to-plane polish, whatever the\n"
-        "                        cube options given: the baseline of the session before it)\n"
+        "                        built with libopen3d-dev); cubes-nopolish (the defaults before\n"
+        "                        the point-to-plane polish: no polish, 5 refine levels,\n"
+        "                        whatever the cube options given)\n"
         "  --edges LIST          cube edges E [m] for the cube methods (default 0.5)\n"
         "  --voxel L             voxel leaf of the *-voxel peer copies [m] (default 0.2)\n"
         "  --trial-seed N        seed of the initial-guess errors (default 1)\n"
@@ -74,8 +75,10 @@ struct Row {
   double es, ea, time;
   long evaluations;
   long j, j_ref;
-  double time_coarse = 0.0, time_refine = 0.0, time_polish = 0.0;
-  int polish_iterations = 0;  // cube methods: stage times [s]
+  double time_coarse = 0.0, time_refine = 0.0, time_polish = 0.0;  // cube methods: stage times [s]
+  int polish_iterations = 0;   // cube methods: the polish's Gauss-Newton steps,
+  double weak_ratio = 0.0;     // its weakest direction's relative information,
+  double sigma_m = 0.0;        // and the largest translation sd of its covariance [m]
   Eigen::Isometry3d estimate = Eigen::Isometry3d::Identity();  // the method's T_target_source
 };
 
@@ -195,6 +198,8 @@ int main(int argc, char** argv) {
         row.time_refine = r.time_refine_s;
         row.time_polish = r.time_polish_s;
         row.polish_iterations = r.polish_iterations;
+        row.weak_ratio = r.weak_ratio;
+        row.sigma_m = std::sqrt(r.covariance.topLeftCorner<3, 3>().diagonal().maxCoeff());
         row.j = r.J;
         row.j_ref = reg->score(d.src_pts, isometryToPose(d.ref));  // untimed, for comparison
       });
@@ -208,7 +213,8 @@ int main(int argc, char** argv) {
           s.grid.cube_edge = e;
           addCube(label.str(), s);
         } else if (m == "cubes-nopolish") {
-          RegistrationSettings s;  // the defaults, not the command line's cube options
+          RegistrationSettings s;  // session 7's defaults, not the command line's cube options
+          s.refine.compass.levels = 5;
           s.grid.cube_edge = e;
           s.polish.enabled = false;
           addCube(label.str(), s);
@@ -244,7 +250,7 @@ int main(int argc, char** argv) {
     std::ofstream csv(csv_path);
     if (!csv) throw std::runtime_error(csv_path + ": cannot write");
     csv << "pair,bounds,method,trial,Es_m,Ea_deg,time_s,evaluations,J,J_ref,time_coarse_s,"
-           "time_refine_s,time_polish_s,polish_iterations,tx,ty,tz,qx,qy,qz,qw\n";
+           "time_refine_s,time_polish_s,polish_iterations,weak_ratio,sigma_m,tx,ty,tz,qx,qy,qz,qw\n";
     std::vector<Row> rows;
     const std::size_t total = pairs.size() * bounds.size() * std::size_t(trials) * table.size();
     std::size_t done = 0;
@@ -284,7 +290,8 @@ int main(int argc, char** argv) {
             csv << row.pair << ',' << row.bounds << ',' << row.method << ',' << row.trial << ','
                 << row.es << ',' << row.ea << ',' << row.time << ',' << row.evaluations << ','
                 << row.j << ',' << row.j_ref << ',' << row.time_coarse << ','
-                << row.time_refine << ',' << row.time_polish << ',' << row.polish_iterations << ',' << poseCsv(row.estimate) << '\n';
+                << row.time_refine << ',' << row.time_polish << ',' << row.polish_iterations << ',' << row.weak_ratio << ',' << row.sigma_m << ','
+                << poseCsv(row.estimate) << '\n';
             ++done;
             const double el = std::chrono::duration<double>(std::chrono::steady_clock::now() -
                                                             bench_start).count();

@@ -65,6 +65,9 @@ struct Row {
   Eigen::Matrix<double, 6, 1> sigma = Eigen::Matrix<double, 6, 1>::Zero();
   bool degenerate = false;
   double weak_ratio = 0.0;
+  bool polished = false;
+  double plane_rms = 0.0, plane_fraction = 0.0;
+  int agreeing = 0, J_runner_up = 0, J_coarse = 0;
   /// The largest |error| / sigma over the six axes (0 without a covariance).
   double maxZ() const {
     double z = 0.0;
@@ -163,7 +166,8 @@ int main(int argc, char** argv) {
     if (!csv) throw std::runtime_error(csv_path + ": cannot write");
     csv << "scene,world,trial,motion,bounds,Es_m,Ea_deg,time_s,J,J_guess,J_truth,gate,success,"
            "ex_m,ey_m,ez_m,erx_rad,ery_rad,erz_rad,sx_m,sy_m,sz_m,srx_rad,sry_rad,srz_rad,"
-           "degenerate,weak_ratio\n";
+           "degenerate,weak_ratio,polished,plane_rms_m,plane_fraction,"
+           "starts_agreeing,J_runner_up,J_coarse\n";
     CubeRegistration reg(settings);
     const GateSettings gate_settings;
     const sim::ScannerModel model;
@@ -195,13 +199,22 @@ int main(int argc, char** argv) {
               row.sigma = r.covariance.diagonal().cwiseMax(0.0).cwiseSqrt();
               row.degenerate = r.degenerate;
               row.weak_ratio = r.weak_ratio;
+              row.polished = r.polished;
+              row.plane_rms = r.plane_rms;
+              row.agreeing = r.starts_agreeing;
+              row.J_runner_up = r.J_runner_up;
+              row.J_coarse = r.J_coarse;
+              row.plane_fraction =
+                  r.polish_points ? double(r.plane_correspondences) / r.polish_points : 0.0;
               csv << row.scene << ',' << w << ',' << t << ',' << row.motion << ',' << row.bounds
                   << ',' << row.es << ',' << row.ea << ',' << row.time << ',' << row.J << ','
                   << row.J_guess << ',' << row.J_truth << ',' << toString(row.reason) << ','
                   << int(row.success());
               for (int k = 0; k < 6; ++k) csv << ',' << row.error(k);
               for (int k = 0; k < 6; ++k) csv << ',' << row.sigma(k);
-              csv << ',' << int(row.degenerate) << ',' << row.weak_ratio << '\n';
+              csv << ',' << int(row.degenerate) << ',' << row.weak_ratio << ',' << int(row.polished)
+                  << ',' << row.plane_rms << ',' << row.plane_fraction << ',' << row.agreeing << ','
+                  << row.J_runner_up << ',' << row.J_coarse << '\n';
               rows.push_back(row);
             }
           }

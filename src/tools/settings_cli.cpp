@@ -43,6 +43,8 @@ std::string algorithmOptionsHelp() {
          "  --polish-min-points N reference points a plane needs (default " + std::to_string(d.polish.min_points) + ")\n"
          "  --polish-collapse F   the polish evaluates one scan point per voxel of F*E, 0 = all\n"
          "                        (default " + num(d.polish.collapse_fraction) + ")\n"
+         "  --polish-weak R       the polish does not move along directions with less than R x\n"
+         "                        the strongest information (default " + num(d.polish.weak_ratio) + ")\n"
          "  --polish-iterations N Gauss-Newton steps of the polish (default " + std::to_string(d.polish.max_iterations) + ")\n"
          "  --covariance-scale C  the polish's covariance is C x sigma^2 H^-1 (default " + num(d.polish.covariance_scale) + ")\n"
          "  --refine-collapse F   the refine stage evaluates one point per voxel of F*E\n"
@@ -100,6 +102,8 @@ bool parseAlgorithmOption(const std::vector<std::string>& args, std::size_t& i,
     s.polish.min_points = int(value(1)), used = 2;
   } else if (a == "--polish-collapse") {
     s.polish.collapse_fraction = value(1), used = 2;
+  } else if (a == "--polish-weak") {
+    s.polish.weak_ratio = value(1), used = 2;
   } else if (a == "--polish-iterations") {
     s.polish.max_iterations = int(value(1)), used = 2;
   } else if (a == "--covariance-scale") {

@@ -1,4 +1,5 @@
-// The acceptance gate: low overlap, no gain and large corrections are rejected with reasons.
+// The acceptance gate: low overlap, no gain, large corrections, unconfirmed and degenerate
+// results are rejected with reasons.
 #include <gtest/gtest.h>
 
 #include "cube_scan_matcher/core/acceptance_gate.h"
@@ -47,4 +48,32 @@ TEST(AcceptanceGate, NoGainIsJudgedOnTheCoarseStage) {
   EXPECT_EQ(gate(r, guess, GateSettings{}), GateReason::Accepted);
   r.J_coarse = 599;
   EXPECT_EQ(gate(r, guess, GateSettings{}), GateReason::NoGain);
+}
+
+// A result the polish ran on but did not apply is unconfirmed; a polished result flagged
+// degenerate is rejected; each only while its switch is on, and a result without the polish
+// (the paper's mode) is judged without them.
+TEST(AcceptanceGate, RejectsUnconfirmedAndDegenerateResults) {
+  RegistrationResult r;
+  r.status = RegistrationStatus::Ok;
+  r.reference_cubes = 1000;
+  r.J = r.J_coarse = 500;
+  r.J_guess = 400;
+  r.transform = poseToIsometry(r.pose);
+  const Pose6 guess = Pose6::Zero();
+  EXPECT_EQ(gate(r, guess, GateSettings{}), GateReason::Accepted);  // no polish ran
+  r.polish_tried = true;
+  EXPECT_EQ(gate(r, guess, GateSettings{}), GateReason::Unconfirmed);
+  GateSettings g;
+  g.require_polish = false;
+  EXPECT_EQ(gate(r, guess, g), GateReason::Accepted);
+  r.polished = true;
+  EXPECT_EQ(gate(r, guess, GateSettings{}), GateReason::Accepted);
+  r.degenerate = true;
+  EXPECT_EQ(gate(r, guess, GateSettings{}), GateReason::Degenerate);
+  g = GateSettings{};
+  g.reject_degenerate = false;
+  EXPECT_EQ(gate(r, guess, g), GateReason::Accepted);
+  EXPECT_EQ(toString(GateReason::Unconfirmed), "unconfirmed");
+  EXPECT_EQ(toString(GateReason::Degenerate), "degenerate");
 }

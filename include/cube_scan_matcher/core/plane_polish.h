@@ -39,9 +39,13 @@ struct PolishSettings {
   double max_shift_rad = 0.03490658503988659;  // 2 deg
   int min_correspondences = 50;
   /// Directions whose information is below weak_ratio times the strongest one (in units where
-  /// 1 rad = 1 m at the scan's radius of gyration) are not moved by the polish and are
-  /// reported as weak (degenerate). In (0, 1).
+  /// 1 rad = 1 m at the scan's radius of gyration) are not moved by the polish (numerically
+  /// empty directions). In (0, 1).
   double weak_ratio = 1e-4;
+  /// The result is flagged degenerate when its weakest direction's information is below this
+  /// times the strongest one's (the simulated streets, halls, parks and hills give 3e-3 to
+  /// 3e-2). In (0, 1).
+  double degenerate_ratio = 1e-3;
   /// The covariance: sigma^2 (H)^-1 from the weighted residuals, times this factor (the
   /// residuals of neighbouring points are correlated, so the raw least-squares covariance is
   /// too small; calibrated on the scene benchmark). In [1, 1e6].
@@ -62,7 +66,7 @@ struct PolishResult {
   /// rotations applied on the left (R' = exp(dtheta) R, t' = t + dt), as ROS's
   /// PoseWithCovariance. Zero when no plane was found.
   Eigen::Matrix<double, 6, 6> covariance = Eigen::Matrix<double, 6, 6>::Zero();
-  bool degenerate = false;  ///< some direction is weak (e.g. along a corridor's axis).
+  bool degenerate = false;  ///< weak_ratio < settings.degenerate_ratio (a corridor's axis).
   /// The weakest direction, unit 6-vector in the same coordinates (rotations scaled by the
   /// radius of gyration), and its information relative to the strongest one.
   Eigen::Matrix<double, 6, 1> weak_direction = Eigen::Matrix<double, 6, 1>::Zero();

@@ -81,14 +81,20 @@ struct RegistrationResult {
   int iterations = 0;              ///< GNMM iterations, all runs.
   int restarts = 0;                ///< GNMM restarts, all runs.
   int J_coarse = 0;  ///< J at E after the first stage, on its points (dense_points filter).
+  /// Ambiguity: the coarse starts whose result lies within 0.25 m / 2 deg of the final pose,
+  /// and the highest coarse J of the others (0 when every start agrees).
+  int starts_agreeing = 0;
+  int J_runner_up = 0;
   double time_s = 0.0;            ///< wall time of align() [s].
   double time_coarse_s = 0.0;     ///< of which the coarse stage (the GNMM starts) [s].
   double time_refine_s = 0.0;     ///< of which the refine stage [s].
   double time_polish_s = 0.0;     ///< of which the polish and its covariance [s].
-  /// The polish (plane_polish.h): whether it moved the pose, its Gauss-Newton steps, the scan
+  /// The polish (plane_polish.h): whether it ran and moved the pose, its Gauss-Newton steps, the scan
   /// points near a reference plane at the result, their weighted RMS distance [m].
+  bool polish_tried = false;  ///< the polish ran (enabled, and the reference has planes)
   bool polished = false;
   int polish_iterations = 0;
+  int polish_points = 0;  ///< scan points the polish evaluated
   int plane_correspondences = 0;
   double plane_rms = 0.0;
   /// Covariance of the pose [x y z, small rotations about the reference frame's x y z]
@@ -147,7 +153,7 @@ class CubeRegistration {
   /// The steps of align(), under the mutex.
   void prepareScan(const PointArray& scan, ScanPoints& points) const;
   void coarseStage(const ScanPoints& points, const Pose6& guess, RegistrationResult& res,
-                   std::vector<Pose6>& ranked) const;
+                   std::vector<Pose6>& ranked, std::vector<int>& ranked_J) const;
   void refineStage(const ScanPoints& points, const std::vector<Pose6>& ranked,
                    RegistrationResult& res) const;
   void polishStage(const ScanPoints& points, RegistrationResult& res) const;

@@ -25,6 +25,7 @@
 #include "cube_scan_matcher/ScanMatcherConfig.h"
 #include "cube_scan_matcher/Status.h"
 #include "cube_scan_matcher/core/online_matcher.h"
+#include "cube_scan_matcher/core/pose_covariance.h"
 #include "cube_scan_matcher/ros/params.h"
 
 namespace cube_scan_matcher {
@@ -92,11 +93,11 @@ class ScanMatcherNodelet : public nodelet::Nodelet {
   std::optional<Eigen::Isometry3d> map_odom_;
   ros::Timer tf_timer_;
 
-  // Variances [m^2], [rad^2] of the current keyframe's pose: a scan's published variance is
-  // these plus one increment's; they grow from keyframe to keyframe (a random walk of the
-  // increments' errors) and restart at the first scan of a chain.
-  double keyframe_var_t_ = 0.0, keyframe_var_r_ = 0.0;
-  std::optional<std::pair<double, double>> start_var_;  // from ~set_pose, for the next first scan
+  // Covariance of the current keyframe's pose in the map frame (pose_covariance.h): a scan's
+  // published covariance is this plus its increment's; it grows from keyframe to keyframe (a
+  // random walk of the increments' errors) and restarts at the first scan of a chain.
+  Matrix6d keyframe_cov_ = Matrix6d::Zero();
+  std::optional<Matrix6d> start_cov_;  // from ~set_pose, for the next first scan
 
   nav_msgs::Path path_;
   std::optional<std::uint32_t> last_seq_;
