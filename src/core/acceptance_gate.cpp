@@ -1,7 +1,10 @@
 #include "cube_scan_matcher/core/acceptance_gate.h"
 
+#include <algorithm>
 #include <cmath>
 #include <stdexcept>
+
+#include <Eigen/Eigenvalues>
 
 namespace cube_scan_matcher {
 
@@ -18,6 +21,7 @@ std::string toString(GateReason reason) {
     case GateReason::BadInput: return "bad_input";
     case GateReason::Unconfirmed: return "unconfirmed";
     case GateReason::Degenerate: return "degenerate";
+    case GateReason::Uncertain: return "uncertain";
   }
   return "unknown";
 }
@@ -31,6 +35,8 @@ void validate(const GateSettings& s) {
     throw std::invalid_argument("max_correction_translation must be > 0 m");
   if (!(s.max_correction_rad > 0.0 && std::isfinite(s.max_correction_rad)))
     throw std::invalid_argument("max_correction_rotation must be > 0");
+  if (!(s.max_sigma_m >= 0.0 && std::isfinite(s.max_sigma_m)))
+    throw std::invalid_argument("max_sigma_translation must be >= 0 m (0 = off)");
 }
 
 Pose6 correctionFromGuess(const Pose6& guess, const Pose6& result) {
@@ -51,6 +57,14 @@ GateReason gate(const RegistrationResult& r, const Pose6& guess, const GateSetti
   }
   if (s.require_polish && r.polish_tried && !r.polished) return GateReason::Unconfirmed;
   if (s.reject_degenerate && r.polished && r.degenerate) return GateReason::Degenerate;
+  if (s.max_sigma_m > 0.0 && r.polished) {
+    // The largest translation standard deviation: over every direction, not only x, y, z.
+    const Eigen::Matrix3d c = r.covariance.topLeftCorner<3, 3>();
+    const double var = Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(c, Eigen::EigenvaluesOnly)
+                           .eigenvalues()
+                           .maxCoeff();
+    if (std::sqrt(std::max(var, 0.0)) > s.max_sigma_m) return GateReason::Uncertain;
+  }
   return GateReason::Accepted;
 }
 

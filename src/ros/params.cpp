@@ -54,6 +54,7 @@ void configToSettings(const ScanMatcherConfig& c, OnlineMatcherSettings& m) {
   m.gate.max_correction_rad = deg2rad(c.max_correction_rotation);
   m.gate.require_polish = c.require_polish;
   m.gate.reject_degenerate = c.reject_degenerate;
+  m.gate.max_sigma_m = c.max_sigma_translation;
   m.max_consecutive_rejections = c.max_consecutive_rejections;
   m.keyframes.distance = c.keyframe_distance;
   m.keyframes.angle = deg2rad(c.keyframe_angle);
@@ -132,6 +133,7 @@ ScanMatcherConfig toConfig(const NodeParams& p) {
   c.max_correction_rotation = rad2deg(p.matcher.gate.max_correction_rad);
   c.require_polish = p.matcher.gate.require_polish;
   c.reject_degenerate = p.matcher.gate.reject_degenerate;
+  c.max_sigma_translation = p.matcher.gate.max_sigma_m;
   c.max_consecutive_rejections = p.matcher.max_consecutive_rejections;
   c.keyframe_distance = p.matcher.keyframes.distance;
   c.keyframe_angle = rad2deg(p.matcher.keyframes.angle);

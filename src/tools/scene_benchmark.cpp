@@ -45,6 +45,11 @@ void usage(std::ostream& os) {
         "                        >= P %% of its trials (default off)\n"
         "  --check-false-accepts N  exit 2 if more than N trials in all are accepted by the\n"
         "                        gate but wrong (default off)\n"
+        "  --repeat K            also register each pair from K starts in each bounds and\n"
+        "                        report the repeatability: the median over pairs of each\n"
+        "                        pair's median distance to its own median pose (default 1 = off)\n"
+        "  --check-repeatability M D  exit 2 unless every group's repeatability is <= M [m]\n"
+        "                        and D [deg] (needs --repeat >= 2; default off)\n"
      << algorithmOptionsHelp();
 }
 
@@ -129,6 +134,8 @@ int main(int argc, char** argv) {
   std::uint64_t seed = 1;
   std::string csv_path = "scenes.csv";
   double check_success = -1, check_false_accepts = -1;
+  int repeat = 1;
+  double check_rep_m = -1, check_rep_deg = -1;
   RegistrationSettings settings;
   RangeFilterSettings filter;
   try {
@@ -151,10 +158,20 @@ int main(int argc, char** argv) {
       else if (a == "--csv") csv_path = v;
       else if (a == "--check-success") check_success = io::parseNumber(a, v);
       else if (a == "--check-false-accepts") check_false_accepts = io::parseNumber(a, v);
+      else if (a == "--repeat") repeat = int(io::parseNumber(a, v));
+      else if (a == "--check-repeatability") {
+        if (i + 2 >= args.size()) throw std::invalid_argument(a + ": expects M D");
+        check_rep_m = io::parseNumber(a, v);
+        check_rep_deg = io::parseNumber(a, args[i + 2]);
+        ++i;
+      }
       else throw std::invalid_argument("unknown option or value: " + a + " " + v);
       i += 2;
     }
     if (worlds < 1 || trials < 1) throw std::invalid_argument("--worlds and --trials must be >= 1");
+    if (repeat < 1) throw std::invalid_argument("--repeat must be >= 1");
+    if (check_rep_m >= 0 && repeat < 2)
+      throw std::invalid_argument("--check-repeatability needs --repeat >= 2");
     for (const std::string& m : motions) {
       if (m != "table1" && m != "random") throw std::invalid_argument("unknown motion: " + m);
     }
@@ -172,6 +189,8 @@ int main(int argc, char** argv) {
     const GateSettings gate_settings;
     const sim::ScannerModel model;
     std::vector<Row> rows;
+    // Per (scene, motion, bounds): each repeated pair's repeatability.
+    std::map<std::tuple<std::string, std::string, std::string>, std::vector<Repeatability>> reps;
     for (const std::string& scene_name : scenes) {
       const sim::SceneType type = sim::sceneTypeFromString(scene_name);
       for (int w = 1; w <= worlds; ++w) {
@@ -216,6 +235,14 @@ int main(int argc, char** argv) {
                   << ',' << row.plane_rms << ',' << row.plane_fraction << ',' << row.agreeing << ','
                   << row.J_runner_up << ',' << row.J_coarse << '\n';
               rows.push_back(row);
+              if (repeat > 1) {
+                std::vector<Eigen::Isometry3d> estimates{r.transform};
+                for (int k = 1; k < repeat; ++k) {
+                  const Pose6 g = isometryToPose(motion * sim::randomTransform(rng, bd.t, bd.a_deg));
+                  estimates.push_back(reg.align(scan, g).transform);
+                }
+                reps[{scene_name, motion_name, bd.name}].push_back(repeatability(estimates));
+              }
             }
           }
         }
@@ -224,9 +251,9 @@ int main(int argc, char** argv) {
     }
 
     // Per (scene, motion, bounds) group.
-    std::printf("%-8s %-7s %-6s %9s %22s %22s %9s %5s %5s %5s %6s %14s\n", "scene", "motion", "bounds",
+    std::printf("%-8s %-7s %-6s %9s %22s %22s %9s %5s %5s %5s %6s %14s %15s\n", "scene", "motion", "bounds",
                 "success", "Es med|p95|max [m]", "Ea med|p95|max [deg]", "median s", "acc",
-                "FA", "FR", ">3sd", "sd_t|sd_r");
+                "FA", "FR", ">3sd", "sd_t|sd_r", repeat > 1 ? "rep [m]|[deg]" : "");
     std::map<std::tuple<std::string, std::string, std::string>, std::vector<const Row*>> groups;
     for (const Row& r : rows) groups[{r.scene, r.motion, r.bounds}].push_back(&r);
     std::vector<std::string> failures;
@@ -250,14 +277,27 @@ int main(int argc, char** argv) {
       }
       false_accepts += fa;
       const double pct = 100.0 * ok / double(group.size());
+      // Repeatability: the median over the group's pairs.
+      std::vector<double> rep_m, rep_deg;
+      for (const Repeatability& q : reps[key]) rep_m.push_back(q.median_m), rep_deg.push_back(q.median_deg);
+      char rep_text[48] = "";
+      if (!rep_m.empty()) std::snprintf(rep_text, sizeof rep_text, "%7.4f|%7.4f", median(rep_m), median(rep_deg));
       std::printf("%-8s %-7s %-6s %4d/%-4zu %6.3f|%6.3f|%7.3f %6.2f|%6.2f|%7.2f %9.3f %5d %5d %5d "
-                  "%5.1f%% %6.4f|%6.3f\n",
+                  "%5.1f%% %6.4f|%6.3f %15s\n",
                   std::get<0>(key).c_str(), std::get<1>(key).c_str(), std::get<2>(key).c_str(), ok,
                   group.size(), median(es), quantile(es, 0.95),
                   *std::max_element(es.begin(), es.end()), median(ea), quantile(ea, 0.95),
                   *std::max_element(ea.begin(), ea.end()), median(time), acc, fa, fr,
                   with_cov ? 100.0 * beyond3 / with_cov : 0.0, sd_t.empty() ? 0.0 : median(sd_t),
-                  sd_r.empty() ? 0.0 : median(sd_r));
+                  sd_r.empty() ? 0.0 : median(sd_r), rep_text);
+      if (check_rep_m >= 0 && !rep_m.empty() &&
+          (median(rep_m) > check_rep_m || median(rep_deg) > check_rep_deg)) {
+        char b[200];
+        std::snprintf(b, sizeof b, "%s %s %s: repeatability %.4f m / %.4f deg > %.4f m / %.4f deg",
+                      std::get<0>(key).c_str(), std::get<1>(key).c_str(), std::get<2>(key).c_str(),
+                      median(rep_m), median(rep_deg), check_rep_m, check_rep_deg);
+        failures.push_back(b);
+      }
       if (check_success >= 0 && pct < check_success) {
         char b[160];
         std::snprintf(b, sizeof b, "%s %s %s: %.1f %% successes < %.1f %%", std::get<0>(key).c_str(),
@@ -268,7 +308,8 @@ int main(int argc, char** argv) {
     std::printf("success: Es < 0.10 m and Ea < 1 deg; acc: accepted by the gate (GateSettings "
                 "defaults); FA: accepted but wrong; FR: rejected but right; >3sd: accepted results with an axis's error beyond 3 predicted "
                 "standard deviations; sd_t|sd_r: median predicted sd [m]|[deg] (norm over axes); "
-                "CSV: %s\n",
+                "rep: median over the pairs of each one's median distance to its own median pose "
+                "from --repeat starts; CSV: %s\n",
                 csv_path.c_str());
     if (check_false_accepts >= 0 && false_accepts > check_false_accepts) {
       failures.push_back(std::to_string(false_accepts) + " false accepts > " +

@@ -77,3 +77,28 @@ TEST(AcceptanceGate, RejectsUnconfirmedAndDegenerateResults) {
   EXPECT_EQ(toString(GateReason::Unconfirmed), "unconfirmed");
   EXPECT_EQ(toString(GateReason::Degenerate), "degenerate");
 }
+
+// A polished result whose translation standard deviation (along any direction) exceeds
+// max_sigma_m is uncertain; 0 turns the check off.
+TEST(AcceptanceGate, RejectsResultsWithAWideCovariance) {
+  RegistrationResult r;
+  r.status = RegistrationStatus::Ok;
+  r.reference_cubes = 1000;
+  r.J = r.J_coarse = 500;
+  r.J_guess = 400;
+  r.transform = poseToIsometry(r.pose);
+  r.polish_tried = r.polished = true;
+  r.covariance.diagonal() << 1e-6, 1e-6, 1e-6, 1e-8, 1e-8, 1e-8;  // 1 mm
+  const Pose6 guess = Pose6::Zero();
+  EXPECT_EQ(gate(r, guess, GateSettings{}), GateReason::Accepted);
+  // 2 cm along the diagonal of x and y: each of x and y alone has 1.4 cm.
+  r.covariance(0, 0) = r.covariance(1, 1) = 2e-4;
+  r.covariance(0, 1) = r.covariance(1, 0) = 2e-4 - 1e-6;
+  EXPECT_EQ(gate(r, guess, GateSettings{}), GateReason::Uncertain);
+  GateSettings g;
+  g.max_sigma_m = 0.0;
+  EXPECT_EQ(gate(r, guess, g), GateReason::Accepted);
+  g.max_sigma_m = -1.0;
+  EXPECT_THROW(validate(g), std::invalid_argument);
+  EXPECT_EQ(toString(GateReason::Uncertain), "uncertain");
+}

@@ -23,6 +23,7 @@ enum class GateReason : std::uint8_t {
   BadInput = 8,            ///< no usable point (empty, all NaN, no x/y/z fields).
   Unconfirmed = 9,  ///< the point-to-plane polish did not confirm the cube result.
   Degenerate = 10,  ///< a direction of the result has (almost) no information.
+  Uncertain = 11,   ///< the result's covariance is too wide.
 };
 std::string toString(GateReason reason);
 
@@ -40,6 +41,11 @@ struct GateSettings {
   /// slide along such a direction; the odometry then carries the increment (scene benchmark:
   /// 5 of 11 wrong results, 2 of 1588 right ones; in a corridor every scan is rejected).
   bool reject_degenerate = true;
+  /// Reject a polished result whose largest translation standard deviation (from its
+  /// covariance, RegistrationResult::covariance, calibrated on the scene benchmark) exceeds
+  /// this [m]; 0 = off. Right results there have 0.3 cm median, 0.55 cm p99, 1.3 cm at most;
+  /// the results that slid ~1 m along the simulated hall 1.2-2.7 cm. >= 0.
+  double max_sigma_m = 0.01;
 };
 
 /// Throws std::invalid_argument naming the bad setting.
