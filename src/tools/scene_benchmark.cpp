@@ -39,7 +39,8 @@ void usage(std::ostream& os) {
         "                        random (1-5 m, +-45 deg yaw) (default table1,random)\n"
         "  --initial-errors B    big (+-1 m, +-8 deg), small (+-0.25 m, +-2 deg) or both\n"
         "                        (default both)\n"
-        "  --seed N              seed of start poses, motions, noise and guesses (default 1)\n"
+        "  --trial-seed N        seed of start poses, motions, noise and guesses (default 1;\n"
+        "                        --seed is the GNMM's)\n"
         "  --csv FILE            one row per registration (default scenes.csv)\n"
         "  --check-success P     exit 2 unless every (scene, motion, bounds) group succeeds in\n"
         "                        >= P %% of its trials (default off)\n"
@@ -154,7 +155,7 @@ int main(int argc, char** argv) {
         else if (v == "small") bounds = {{"small", 0.25, 2.0}};
         else if (v == "both") bounds = {{"big", 1.0, 8.0}, {"small", 0.25, 2.0}};
         else throw std::invalid_argument("--initial-errors: expected big, small or both");
-      } else if (a == "--seed") seed = std::uint64_t(io::parseNumber(a, v));
+      } else if (a == "--trial-seed") seed = std::uint64_t(io::parseNumber(a, v));
       else if (a == "--csv") csv_path = v;
       else if (a == "--check-success") check_success = io::parseNumber(a, v);
       else if (a == "--check-false-accepts") check_false_accepts = io::parseNumber(a, v);

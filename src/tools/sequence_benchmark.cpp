@@ -35,7 +35,8 @@ void usage(std::ostream& os) {
   os << "usage: sequence_benchmark (--scene NAME | --dir DIR) [options]\n"
         "  --scene NAME          simulated run: hall, urban, park or natural\n"
         "  --length M            simulated path length [m] (default 500)\n"
-        "  --seed N              world, trajectory and noise seed (default 1)\n"
+        "  --world-seed N        world, trajectory and noise seed (default 1; --seed is the\n"
+        "                        GNMM's)\n"
         "  --dir DIR             real sequence: DIR/*.pcd|*.ply in name order + DIR/poses.tum\n"
         "  --odometry MODE       none, small, big, drift: odometry = truth with the simulator's\n"
         "                        errors per increment (motion.h); cv: no odometry, constant\n"
@@ -189,7 +190,7 @@ int main(int argc, char** argv) {
       if (a == "--scene") scene_name = v;
       else if (a == "--dir") dir = v;
       else if (a == "--length") length = io::parseNumber(a, v);
-      else if (a == "--seed") seed = std::uint64_t(io::parseNumber(a, v));
+      else if (a == "--world-seed") seed = std::uint64_t(io::parseNumber(a, v));
       else if (a == "--odometry") odometry_mode = v;
       else if (a == "--period") period = io::parseNumber(a, v);
       else if (a == "--step") motion.step = io::parseNumber(a, v);
