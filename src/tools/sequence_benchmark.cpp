@@ -53,7 +53,9 @@ void usage(std::ostream& os) {
         "                        (default cubes,cubes-s2s,gicp,ndt)\n"
         "  --submap K            keyframes merged in cubes-submap (default 3)\n"
         "  --keyframe-distance M, --keyframe-angle DEG   keyframe thresholds of the cube methods\n"
-        "  --no-motion-candidate 0|1  without odometry, also search from no motion (default 1)\n"
+        "  --no-motion-candidate 0|1  without odometry, also search from no motion (default 1)\n"        "  --reject-degenerate B, --require-polish B, --max-sigma M  the gate's criteria\n"
+        "                        (GateSettings; B = 0 or 1, M [m], 0 = off)\n"
+
         "  --voxel L             peers' voxel leaf [m] (default 0.2)\n"
         "  --csv FILE            per-scan trajectories (default sequence.csv)\n"
         "  --summary FILE        one line per method appended (default: none)\n"
@@ -200,6 +202,9 @@ int main(int argc, char** argv) {
       else if (a == "--keyframe-angle") matcher_settings.keyframes.angle = deg2rad(io::parseNumber(a, v));
       else if (a == "--voxel") voxel = io::parseNumber(a, v);
       else if (a == "--no-motion-candidate") matcher_settings.no_motion_candidate = io::parseNumber(a, v) != 0.0;
+      else if (a == "--reject-degenerate") matcher_settings.gate.reject_degenerate = io::parseNumber(a, v) != 0.0;
+      else if (a == "--require-polish") matcher_settings.gate.require_polish = io::parseNumber(a, v) != 0.0;
+      else if (a == "--max-sigma") matcher_settings.gate.max_sigma_m = io::parseNumber(a, v);
       else if (a == "--csv") csv_path = v;
       else if (a == "--summary") summary_path = v;
       else if (a == "--label") label = v;
