@@ -43,9 +43,11 @@ struct GateSettings {
   bool reject_degenerate = true;
   /// Reject a polished result whose largest translation standard deviation (from its
   /// covariance, RegistrationResult::covariance, calibrated on the scene benchmark) exceeds
-  /// this [m]; 0 = off. Right results there have 0.3 cm median, 0.55 cm p99, 1.3 cm at most;
-  /// the results that slid ~1 m along the simulated hall 1.2-2.7 cm. >= 0.
-  double max_sigma_m = 0.01;
+  /// this [m]; 0 = off. On the simulator right results have 0.3 cm median, 1.3 cm at most and
+  /// the results that slid ~1 m along the hall 1.1-2.7 cm, so 1 cm would reject those; but a
+  /// right registration of the real corridor pair (3dtk, replayed through the nodelet) has
+  /// 1.3 cm: the bound is a sanity bound, not a separator. >= 0.
+  double max_sigma_m = 0.03;
 };
 
 /// Throws std::invalid_argument naming the bad setting.
