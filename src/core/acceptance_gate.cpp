@@ -1,10 +1,9 @@
 #include "cube_scan_matcher/core/acceptance_gate.h"
 
-#include <algorithm>
 #include <cmath>
 #include <stdexcept>
 
-#include <Eigen/Eigenvalues>
+#include "cube_scan_matcher/core/pose_covariance.h"
 
 namespace cube_scan_matcher {
 
@@ -57,13 +56,8 @@ GateReason gate(const RegistrationResult& r, const Pose6& guess, const GateSetti
   }
   if (s.require_polish && r.polish_tried && !r.polished) return GateReason::Unconfirmed;
   if (s.reject_degenerate && r.polished && r.degenerate) return GateReason::Degenerate;
-  if (s.max_sigma_m > 0.0 && r.polished) {
-    // The largest translation standard deviation: over every direction, not only x, y, z.
-    const Eigen::Matrix3d c = r.covariance.topLeftCorner<3, 3>();
-    const double var = Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(c, Eigen::EigenvaluesOnly)
-                           .eigenvalues()
-                           .maxCoeff();
-    if (std::sqrt(std::max(var, 0.0)) > s.max_sigma_m) return GateReason::Uncertain;
+  if (s.max_sigma_m > 0.0 && r.polished && largestTranslationSigma(r.covariance) > s.max_sigma_m) {
+    return GateReason::Uncertain;
   }
   return GateReason::Accepted;
 }

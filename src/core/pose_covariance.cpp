@@ -1,6 +1,9 @@
 #include "cube_scan_matcher/core/pose_covariance.h"
 
 #include <algorithm>
+#include <cmath>
+
+#include <Eigen/Eigenvalues>
 
 namespace cube_scan_matcher {
 
@@ -11,6 +14,13 @@ Matrix6d floorCovariance(const Matrix6d& covariance, double sigma_m, double sigm
     c(i, i) = std::max(c(i, i), floor);
   }
   return c;
+}
+
+double largestTranslationSigma(const Matrix6d& covariance) {
+  const Eigen::Matrix3d c = covariance.topLeftCorner<3, 3>();
+  const double var =
+      Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(c, Eigen::EigenvaluesOnly).eigenvalues().maxCoeff();
+  return std::sqrt(std::max(var, 0.0));
 }
 
 Matrix6d diagonalCovariance(double sigma_m, double sigma_rad) {

@@ -18,6 +18,7 @@
 
 #include "cube_scan_matcher/core/filters.h"
 #include "cube_scan_matcher/core/metrics.h"
+#include "cube_scan_matcher/core/pose_covariance.h"
 #include "cube_scan_matcher/core/registration.h"
 #include "cube_scan_matcher/io/cloud_io.h"
 #include "cube_scan_matcher/io/dataset.h"
@@ -199,7 +200,7 @@ int main(int argc, char** argv) {
         row.time_polish = r.time_polish_s;
         row.polish_iterations = r.polish_iterations;
         row.weak_ratio = r.weak_ratio;
-        row.sigma_m = std::sqrt(r.covariance.topLeftCorner<3, 3>().diagonal().maxCoeff());
+        row.sigma_m = largestTranslationSigma(r.covariance);
         row.j = r.J;
         row.j_ref = reg->score(d.src_pts, isometryToPose(d.ref));  // untimed, for comparison
       });

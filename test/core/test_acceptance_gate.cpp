@@ -50,16 +50,24 @@ TEST(AcceptanceGate, NoGainIsJudgedOnTheCoarseStage) {
   EXPECT_EQ(gate(r, guess, GateSettings{}), GateReason::NoGain);
 }
 
-// A result the polish ran on but did not apply is unconfirmed; a polished result flagged
-// degenerate is rejected; each only while its switch is on, and a result without the polish
-// (the paper's mode) is judged without them.
-TEST(AcceptanceGate, RejectsUnconfirmedAndDegenerateResults) {
+namespace {
+/// A result the first checks accept: overlap 0.5, J 100 above J at the guess, no correction.
+RegistrationResult gainingResult() {
   RegistrationResult r;
   r.status = RegistrationStatus::Ok;
   r.reference_cubes = 1000;
   r.J = r.J_coarse = 500;
   r.J_guess = 400;
   r.transform = poseToIsometry(r.pose);
+  return r;
+}
+}  // namespace
+
+// A result the polish ran on but did not apply is unconfirmed; a polished result flagged
+// degenerate is rejected; each only while its switch is on, and a result without the polish
+// (the paper's mode) is judged without them.
+TEST(AcceptanceGate, RejectsUnconfirmedAndDegenerateResults) {
+  RegistrationResult r = gainingResult();
   const Pose6 guess = Pose6::Zero();
   EXPECT_EQ(gate(r, guess, GateSettings{}), GateReason::Accepted);  // no polish ran
   r.polish_tried = true;
@@ -81,12 +89,7 @@ TEST(AcceptanceGate, RejectsUnconfirmedAndDegenerateResults) {
 // A polished result whose translation standard deviation (along any direction) exceeds
 // max_sigma_m is uncertain; 0 turns the check off.
 TEST(AcceptanceGate, RejectsResultsWithAWideCovariance) {
-  RegistrationResult r;
-  r.status = RegistrationStatus::Ok;
-  r.reference_cubes = 1000;
-  r.J = r.J_coarse = 500;
-  r.J_guess = 400;
-  r.transform = poseToIsometry(r.pose);
+  RegistrationResult r = gainingResult();
   r.polish_tried = r.polished = true;
   r.covariance.diagonal() << 1e-6, 1e-6, 1e-6, 1e-8, 1e-8, 1e-8;  // 1 mm
   const Pose6 guess = Pose6::Zero();

@@ -16,6 +16,10 @@ using Matrix6d = Eigen::Matrix<double, 6, 6>;
 /// semi-definite). A zero `covariance` (no estimate) gives the diagonal of the floors.
 Matrix6d floorCovariance(const Matrix6d& covariance, double sigma_m, double sigma_rad);
 
+/// The largest translation standard deviation of `covariance` [m], over every direction (the
+/// square root of the largest eigenvalue of its translation block; 0 for a zero covariance).
+double largestTranslationSigma(const Matrix6d& covariance);
+
 /// A diagonal covariance of standard deviations sigma_m [m] and sigma_rad [rad].
 Matrix6d diagonalCovariance(double sigma_m, double sigma_rad);
 
