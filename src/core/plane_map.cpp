@@ -20,10 +20,11 @@ PlaneMap::PlaneMap(PlaneMap&&) noexcept = default;
 PlaneMap& PlaneMap::operator=(PlaneMap&&) noexcept = default;
 
 PlaneMap::PlaneMap(const PointArray& reference, double voxel, int min_points,
-                   double max_planarity)
+                   double max_planarity, double min_spread)
     : voxel_(voxel),
       inv_(float(1.0 / voxel)),
       min_points_(min_points),
+      min_spread_(min_spread),
       max_planarity_(max_planarity) {
   if (!(voxel > 0.0)) throw std::invalid_argument("plane map voxel must be > 0 m");
   keys_ = std::make_unique<detail::KeySet>(reference.size());
@@ -72,6 +73,7 @@ void PlaneMap::fit(std::size_t index, std::int64_t ix, std::int64_t iy, std::int
   eig.computeDirect(cov);
   const Eigen::Vector3d& l = eig.eigenvalues();  // increasing
   if (!(l(0) <= max_planarity_ * l(1)) || !(l(1) > 0.0)) return;
+  if (l(1) < min_spread_ * min_spread_ * voxel_ * voxel_) return;
   // The offset is the mean of the voxel's own points: on a curved surface (a tree's canopy, a
   // pillar) the mean of the whole block lies a sagitta inside the surface, and every point
   // near it would be pulled towards the centre of curvature (a bias along the direction the

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <vector>
 
 #include <Eigen/Eigenvalues>
 #include <Eigen/Geometry>
@@ -25,6 +26,10 @@ void validate(const PolishSettings& s) {
   requireInRange("polish.min_correspondences", s.min_correspondences, 6, 1000000);
   requireInRange("polish.weak_ratio", s.weak_ratio, 1e-9, 0.999);
   requireInRange("polish.degenerate_ratio", s.degenerate_ratio, 1e-12, 0.999);
+  requireInRange("polish.translation_degenerate_ratio", s.translation_degenerate_ratio, 1e-12, 0.999);
+  requireInRange("polish.min_spread", s.min_spread, 0.0, 1.0);
+  requireInRange("polish.support_cosine", s.support_cosine, 0.0, 0.999);
+  requireInRange("polish.degenerate_sigma_m", s.degenerate_sigma_m, 0.0, 1e3);
   requireInRange("polish.covariance_scale", s.covariance_scale, 1.0, 1e6);
 }
 
@@ -44,10 +49,18 @@ struct Linearisation {
   int count = 0;
 };
 
+/// One correspondence's Jacobian row and weight.
+struct Row {
+  Vector6 J;
+  double w;
+};
+
 /// With `near`, also collects the scan points that found a plane (the only ones the later
-/// iterations need to look at: the pose moves by millimetres).
+/// iterations need to look at: the pose moves by millimetres); with `rows`, every
+/// correspondence's Jacobian row and weight.
 Linearisation linearise(const PlaneMap& map, const PointArray& scan, const Eigen::Matrix3d& R,
-                        const Eigen::Vector3d& t, double kernel, PointArray* near = nullptr) {
+                        const Eigen::Vector3d& t, double kernel, PointArray* near = nullptr,
+                        std::vector<Row>* rows = nullptr) {
   Linearisation L;
   const double k2 = kernel * kernel;
   const double max_r = map.voxel();
@@ -65,6 +78,7 @@ Linearisation linearise(const PlaneMap& map, const PointArray& scan, const Eigen
     J.head<3>() = plane->normal;
     J.tail<3>() = rp.cross(plane->normal);
     L.H.selfadjointView<Eigen::Upper>().rankUpdate(J, w);
+    if (rows) rows->push_back({J, w});
     L.g.noalias() += (w * r) * J;
     L.weight += w;
     L.weighted_r2 += w * r * r;
@@ -159,7 +173,8 @@ PolishResult polishOnPlanes(const PlaneMap& map, const PointArray& scan, const P
     }
     if (!converged) break;
   }
-  if (!converged) L = linearise(map, near.empty() ? scan : near, R, t, s.kernel);
+  std::vector<Row> rows;
+  L = linearise(map, near.empty() ? scan : near, R, t, s.kernel, nullptr, &rows);
   res.correspondences = L.count;
   if (L.count < s.min_correspondences || L.weight <= 6.0) {
     res.reason = "too few points near a reference plane";
@@ -192,7 +207,45 @@ PolishResult polishOnPlanes(const PlaneMap& map, const PointArray& scan, const P
                    sp.scale.asDiagonal();
   res.weak_ratio = sp.max_eigenvalue > 0.0 ? sp.eig.eigenvalues()(0) / sp.max_eigenvalue : 0.0;
   res.weak_direction = sp.eig.eigenvectors().col(0);
-  res.degenerate = res.weak_ratio < s.degenerate_ratio;
+
+  // Translation alone: the normals' information sum w n n^T along its eigenvectors, counted
+  // only from the planes that lean towards each by support_cosine. In a tunnel the fitted
+  // normals' small tilts (and a few fits across a corner) would otherwise give its axis 0.3-2 %
+  // of the floor's information, a 1-2 cm sd and a wrong pose accepted 1-2 m along the axis.
+  Eigen::Matrix3d Ht = Eigen::Matrix3d::Zero();
+  for (const Row& row : rows) Ht.noalias() += row.w * row.J.head<3>() * row.J.head<3>().transpose();
+  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> et(Ht);
+  Eigen::Vector3d t_info = Eigen::Vector3d::Zero();
+  for (const Row& row : rows) {
+    for (int k = 0; k < 3; ++k) {
+      const double c = row.J.head<3>().dot(et.eigenvectors().col(k));
+      if (std::abs(c) >= s.support_cosine) t_info(k) += row.w * c * c;
+    }
+  }
+  int t_weakest = 0;
+  for (int k = 1; k < 3; ++k) {
+    if (t_info(k) < t_info(t_weakest)) t_weakest = k;
+  }
+  const Eigen::Vector3d u = et.eigenvectors().col(t_weakest);
+  res.translation_weak_axis = u;
+  res.translation_weak_ratio = t_info.maxCoeff() > 0.0 ? t_info(t_weakest) / t_info.maxCoeff() : 0.0;
+  // Along that axis the variance is at least what the supported information gives.
+  const double t_floor = std::max(t_info.maxCoeff() * 1e-12, 1e-300);
+  const double supported_var = s.covariance_scale * sigma2 / std::max(t_info(t_weakest), t_floor);
+  const double var_u = u.dot(res.covariance.topLeftCorner<3, 3>() * u);
+  if (supported_var > var_u) {
+    res.covariance.topLeftCorner<3, 3>() += (supported_var - var_u) * u * u.transpose();
+  }
+  const bool translation_degenerate = res.translation_weak_ratio < s.translation_degenerate_ratio;
+  if (translation_degenerate) {
+    // Nothing fixes the pose along u: the scan cannot tell its error there (the cube stages
+    // leave it near the guess), so its sd is degenerate_sigma_m at least.
+    const double floor_var = s.degenerate_sigma_m * s.degenerate_sigma_m;
+    const double now = u.dot(res.covariance.topLeftCorner<3, 3>() * u);
+    if (floor_var > now) res.covariance.topLeftCorner<3, 3>() += (floor_var - now) * u * u.transpose();
+    if (res.weak_ratio >= s.degenerate_ratio) res.weak_direction << u, 0.0, 0.0, 0.0;
+  }
+  res.degenerate = res.weak_ratio < s.degenerate_ratio || translation_degenerate;
   return res;
 }
 

@@ -25,7 +25,8 @@ ReferenceGrids buildReferenceGrids(const PointArray& reference, const CubeGridSe
   runOnThreads(jobs, threads, [&](int k, int) {
     try {
       if (k == int(specs.size())) {
-        plane_map = PlaneMap(reference, planes.voxel, planes.min_points, planes.max_planarity);
+        plane_map = PlaneMap(reference, planes.voxel, planes.min_points, planes.max_planarity,
+                             planes.min_spread);
       } else {
         grids[std::size_t(k)] = CubeGrid::build(reference, specs[std::size_t(k)]);
       }

@@ -119,6 +119,7 @@ void CubeRegistration::setReference(const PointArray& reference) {
   planes.voxel = s.polish.voxel_fraction * s.grid.cube_edge;
   planes.min_points = s.polish.min_points;
   planes.max_planarity = s.polish.max_planarity;
+  planes.min_spread = s.polish.min_spread;
   auto next = std::make_unique<ReferenceGrids>(
       buildReferenceGrids(reference, s.grid, s.refine.enabled ? s.refine.grids : 0,
                           s.refine.edge_fraction, s.search.threads, planes));
@@ -243,6 +244,8 @@ void CubeRegistration::polishStage(const ScanPoints& points, RegistrationResult&
   res.degenerate = p.degenerate;
   res.weak_direction = p.weak_direction;
   res.weak_ratio = p.weak_ratio;
+  res.translation_weak_axis = p.translation_weak_axis;
+  res.translation_weak_ratio = p.translation_weak_ratio;
 }
 
 RegistrationResult CubeRegistration::align(const PointArray& scan, const Pose6& guess) const {

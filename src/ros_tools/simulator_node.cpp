@@ -106,7 +106,9 @@ int main(int argc, char** argv) {
       const Eigen::Isometry3d odom = odometry.next(truth);
       sim::SweepOptions options;
       options.keep_invalid = organized;
-      const PointArray pts = sim::scan(scene, model, truth * mount, rng, options);
+      const double t = k * period;  // what moves (the crowd's people and cars) is where it is now
+      const PointArray pts =
+          sim::scan(scene.movers.empty() ? scene : scene.at(t), model, truth * mount, rng, options);
       ros::Time stamp;
       {
         std::lock_guard<std::mutex> lock(odom_mutex);

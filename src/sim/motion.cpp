@@ -29,10 +29,16 @@ Eigen::Isometry3d paperTable1Motion(SceneType type) {
   };
   Row r{};
   switch (type) {
-    case SceneType::Hall: r = {-2.570, 3.144, -0.029, -20.858, 1.651, 5.999}; break;
-    case SceneType::Urban: r = {0.406, 3.662, 0.053, 27.126, 5.282, -6.127}; break;
-    case SceneType::Park: r = {2.541, 4.696, 0.133, -44.106, -0.717, 6.294}; break;
-    case SceneType::Natural: r = {0.732, 2.516, -0.049, -1.675, -14.666, -2.258}; break;
+    case SceneType::Hall:
+    case SceneType::Tunnel: r = {-2.570, 3.144, -0.029, -20.858, 1.651, 5.999}; break;
+    case SceneType::Urban:
+    case SceneType::Square:
+    case SceneType::Wall:
+    case SceneType::Crowd: r = {0.406, 3.662, 0.053, 27.126, 5.282, -6.127}; break;
+    case SceneType::Park:
+    case SceneType::Forest: r = {2.541, 4.696, 0.133, -44.106, -0.717, 6.294}; break;
+    case SceneType::Natural:
+    case SceneType::Slope: r = {0.732, 2.516, -0.049, -1.675, -14.666, -2.258}; break;
   }
   Eigen::Isometry3d paper = Eigen::Isometry3d::Identity();
   paper.translation() = Eigen::Vector3d(r.x0, r.y0, r.z0);

@@ -8,12 +8,11 @@
 
 namespace cube_scan_matcher::sim {
 
-SceneType sceneTypeFromString(const std::string& name) {
-  if (name == "hall") return SceneType::Hall;
-  if (name == "urban") return SceneType::Urban;
-  if (name == "park") return SceneType::Park;
-  if (name == "natural") return SceneType::Natural;
-  throw std::invalid_argument("unknown scene '" + name + "' (expected hall, urban, park or natural)");
+const std::vector<SceneType>& allSceneTypes() {
+  static const std::vector<SceneType> all = {
+      SceneType::Hall,   SceneType::Urban,  SceneType::Park, SceneType::Natural, SceneType::Square,
+      SceneType::Slope,  SceneType::Forest, SceneType::Tunnel, SceneType::Wall,  SceneType::Crowd};
+  return all;
 }
 
 std::string toString(SceneType type) {
@@ -22,8 +21,23 @@ std::string toString(SceneType type) {
     case SceneType::Urban: return "urban";
     case SceneType::Park: return "park";
     case SceneType::Natural: return "natural";
+    case SceneType::Square: return "square";
+    case SceneType::Slope: return "slope";
+    case SceneType::Forest: return "forest";
+    case SceneType::Tunnel: return "tunnel";
+    case SceneType::Wall: return "wall";
+    case SceneType::Crowd: return "crowd";
   }
   return "unknown";
+}
+
+SceneType sceneTypeFromString(const std::string& name) {
+  std::string known;
+  for (const SceneType t : allSceneTypes()) {
+    if (toString(t) == name) return t;
+    known += (known.empty() ? "" : ", ") + toString(t);
+  }
+  throw std::invalid_argument("unknown scene '" + name + "' (expected one of " + known + ")");
 }
 
 namespace {
@@ -81,106 +95,36 @@ double hitSphere(const Sphere& s, const Eigen::Vector3d& o, const Eigen::Vector3
   return kNone;
 }
 
-struct Builder {
-  Scene s;
-  std::mt19937_64 rng;
-  explicit Builder(std::uint64_t seed) : rng(seed) {}
-  double u(double a, double b) { return std::uniform_real_distribution<double>(a, b)(rng); }
-  void ground(double slope_x = 0.0, double slope_y = 0.0) {
-    s.planes.push_back({Eigen::Vector3d(-slope_x, -slope_y, 1.0).normalized(), 0.0});
-  }
-  void box(double x, double y, double z, double sx, double sy, double sz) {
-    s.boxes.push_back({Eigen::Vector3d(x - sx / 2, y - sy / 2, z), Eigen::Vector3d(x + sx / 2, y + sy / 2, z + sz)});
-  }
-  void tree(double x, double y, double z) {
-    const double h = u(2.5, 5.0);
-    s.cylinders.push_back({x, y, u(0.12, 0.35), z - 0.5, z + h});
-    s.spheres.push_back({Eigen::Vector3d(x, y, z + h + u(0.5, 1.2)), u(1.2, 2.5)});
-  }
-};
 }  // namespace
 
-Scene Scene::generate(SceneType type, std::uint64_t seed) {
-  Builder b(seed * 7919 + std::uint64_t(type));
-  switch (type) {
-    case SceneType::Hall: {
-      // A large hall, 160 x 30 m and 7 m high, with columns, furniture and partitions.
-      b.ground();
-      b.s.planes.push_back({Eigen::Vector3d(0, 0, -1), -7.0});  // ceiling at z = 7
-      b.box(60, 16, 0, 170, 1, 7);   // left wall
-      b.box(60, -16, 0, 170, 1, 7);  // right wall
-      b.box(-25, 0, 0, 1, 32, 7);    // back wall
-      b.box(145, 0, 0, 1, 32, 7);    // front wall
-      for (double x = -15; x < 140; x += 12) {
-        b.s.cylinders.push_back({x, 8.0, 0.35, 0, 7});
-        b.s.cylinders.push_back({x + 6, -8.0, 0.35, 0, 7});
-      }
-      for (int i = 0; i < 45; ++i) {
-        const double x = b.u(-20, 140), y = b.u(-14, 14);
-        if (std::abs(y) < 2.5) continue;  // keep the robot's aisle free
-        b.box(x, y, 0, b.u(0.5, 3), b.u(0.5, 3), b.u(0.5, 2.5));
-      }
-      for (int i = 0; i < 8; ++i) b.box(b.u(-10, 130), b.u(8, 13) * (i % 2 ? 1 : -1), 0, b.u(3, 8), 0.2, b.u(2, 3.5));
-      break;
-    }
-    case SceneType::Urban: {
-      // A street along x: building blocks with gaps on both sides, poles, parked cars, walls.
-      b.ground();
-      for (int side : {-1, 1}) {
-        for (double x = -30; x < 160;) {
-          const double len = b.u(8, 25), depth = b.u(8, 20), h = b.u(6, 25);
-          const double y = side * (b.u(9, 13) + depth / 2);
-          b.box(x + len / 2, y, 0, len, depth, h);
-          x += len + b.u(2, 10);
-        }
-        for (double x = -25; x < 155; x += b.u(7, 12)) b.s.cylinders.push_back({x, side * b.u(6.5, 7.5), 0.12, 0, b.u(4, 8)});
-        for (int i = 0; i < 14; ++i) b.box(b.u(-25, 150), side * b.u(4.5, 5.5), 0, b.u(3.8, 4.8), 1.8, b.u(1.3, 1.8));
-      }
-      for (int i = 0; i < 6; ++i) b.box(b.u(-20, 150), b.u(-8, 8), 0, b.u(0.3, 0.6), b.u(2, 6), b.u(0.8, 1.5));
-      break;
-    }
-    case SceneType::Park: {
-      // Gently sloped lawn with trees (trunks and canopies), benches and a few lamp posts.
-      b.ground(0.03, -0.02);
-      for (int i = 0; i < 110; ++i) {
-        const double x = b.u(-30, 160), y = b.u(-45, 45);
-        if (std::abs(y) < 3) continue;
-        b.tree(x, y, b.s.groundHeight(x, y));
-      }
-      for (int i = 0; i < 25; ++i) {
-        const double x = b.u(-30, 160), y = b.u(-30, 30);
-        if (std::abs(y) < 3) continue;
-        b.box(x, y, b.s.groundHeight(x, y) - 0.2, b.u(1.5, 2.0), 0.6, 1.0);
-      }
-      for (double x = -20; x < 160; x += 15) b.s.cylinders.push_back({x, 4.0, 0.1, -1, b.s.groundHeight(x, 4) + 4});
-      break;
-    }
-    case SceneType::Natural: {
-      // Uneven sloped terrain (buried spheres make hills and hollows), rocks, sparse bushes.
-      b.ground(-0.04, 0.05);
-      for (int i = 0; i < 40; ++i) {
-        const double x = b.u(-40, 170), y = b.u(-60, 60), r = b.u(8, 30);
-        if (std::abs(y) < r * 0.4 + 4) continue;
-        b.s.spheres.push_back({Eigen::Vector3d(x, y, b.s.groundHeight(x, y) - r + b.u(0.5, 3.0)), r});
-      }
-      for (int i = 0; i < 120; ++i) {
-        const double x = b.u(-30, 160), y = b.u(-40, 40), r = b.u(0.2, 1.4);
-        if (std::abs(y) < 2 + r) continue;
-        b.s.spheres.push_back({Eigen::Vector3d(x, y, b.s.groundHeight(x, y) + r * 0.3), r});
-      }
-      for (int i = 0; i < 50; ++i) {
-        const double x = b.u(-30, 160), y = b.u(-40, 40);
-        if (std::abs(y) < 3) continue;
-        if (i % 3 == 0) {
-          b.tree(x, y, b.s.groundHeight(x, y));
-        } else {
-          b.s.spheres.push_back({Eigen::Vector3d(x, y, b.s.groundHeight(x, y) + 0.4), b.u(0.4, 1.0)});
-        }
-      }
-      break;
+Scene Scene::at(double t) const {
+  Scene out = *this;
+  out.movers.clear();
+  for (const Mover& m : movers) {
+    const Eigen::Vector3d p = m.p0 + t * m.v;
+    if (m.car) {
+      out.boxes.push_back({p + Eigen::Vector3d(-2.25, -0.9, 0.0), p + Eigen::Vector3d(2.25, 0.9, 1.5)});
+    } else {
+      out.cylinders.push_back({p.x(), p.y(), 0.25, p.z(), p.z() + 1.7});
     }
   }
-  return b.s;
+  return out;
+}
+
+bool Scene::insideSolid(const Eigen::Vector3d& p, double margin) const {
+  for (const Box& b : boxes) {
+    if ((p.array() >= b.lo.array() - margin).all() && (p.array() <= b.hi.array() + margin).all())
+      return true;
+  }
+  for (const Cylinder& c : cylinders) {
+    if (std::hypot(p.x() - c.cx, p.y() - c.cy) < c.r + margin && p.z() > c.z0 - margin &&
+        p.z() < c.z1 + margin)
+      return true;
+  }
+  for (const Sphere& s : spheres) {
+    if ((p - s.c).norm() < s.r + margin) return true;
+  }
+  return false;
 }
 
 double Scene::groundHeight(double x, double y) const {
@@ -199,7 +143,14 @@ double Scene::raycast(const Eigen::Vector3d& o, const Eigen::Vector3d& d, double
   for (const Box& b : boxes) t = std::min(t, hitBox(b, o, d));
   for (const Cylinder& c : cylinders) t = std::min(t, hitCylinder(c, o, d));
   for (const Sphere& s : spheres) t = std::min(t, hitSphere(s, o, d));
-  return t <= max_range ? t : -1.0;
+  if (t > max_range) return -1.0;
+  if (!no_return.empty()) {
+    const Eigen::Vector3d hit = o + t * d;
+    for (const Sphere& s : no_return) {
+      if ((hit - s.c).squaredNorm() < s.r * s.r) return -1.0;
+    }
+  }
+  return t;
 }
 
 }  // namespace cube_scan_matcher::sim

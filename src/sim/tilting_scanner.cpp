@@ -2,6 +2,7 @@
 
 #include <cmath>
 #include <limits>
+#include <vector>
 
 #include "cube_scan_matcher/core/pose.h"
 
@@ -30,6 +31,7 @@ PointArray scan(const Scene& full_scene, const ScannerModel& m, const Eigen::Iso
   const Eigen::Vector3d o = pose.translation();
   Scene scene;
   scene.planes = full_scene.planes;
+  scene.no_return = full_scene.no_return;
   const double reach = m.max_range + 1.0;
   for (const Box& b : full_scene.boxes) {
     const Eigen::Vector3d c = o.cwiseMax(b.lo).cwiseMin(b.hi);
@@ -47,28 +49,57 @@ PointArray scan(const Scene& full_scene, const ScannerModel& m, const Eigen::Iso
   PointArray out;
   out.reserve(std::size_t(m.phiCount()) * m.psiCount());
   const Eigen::Matrix3d rot = pose.linear();
+  std::uniform_real_distribution<double> unit(0.0, 1.0);
+  std::vector<double> range(std::size_t(m.phiCount()));
+  std::vector<Eigen::Vector3d> dirs(range.size());
   for (int j = 0; j < m.psiCount(); ++j) {
     const double psi = deg2rad(m.psi_min_deg + j * m.psi_step_deg);
     for (int i = 0; i < m.phiCount(); ++i) {
       const double phi = deg2rad(m.phi_min_deg + i * m.phi_step_deg);
       // Eq. (1) with r = 1: the beam direction in the sensor frame.
-      const Eigen::Vector3d dir(std::cos(phi), std::cos(psi) * std::sin(phi),
-                                std::sin(psi) * std::sin(phi));
-      const double t = scene.raycast(o, rot * dir, m.max_range);
-      if (t <= 0.0) {
+      dirs[i] = Eigen::Vector3d(std::cos(phi), std::cos(psi) * std::sin(phi), std::sin(psi) * std::sin(phi));
+      range[i] = scene.raycast(o, rot * dirs[i], m.max_range);
+    }
+    for (int i = 0; i < m.phiCount(); ++i) {
+      const double t = range[i];
+      if (t <= 0.0 || (m.dropout > 0.0 && unit(rng) < m.dropout)) {
         if (options.keep_invalid) out.push_back(nan, nan, nan);
         continue;
       }
-      const double r = t + noise(rng);
+      double r = t + noise(rng);
+      if (m.mixed_pixels > 0.0) {
+        // The neighbour across the larger range jump, if it is an edge.
+        double jump = 0.0;
+        for (int k : {i - 1, i + 1}) {
+          if (k < 0 || k >= m.phiCount() || range[k] <= 0.0) continue;
+          if (std::abs(range[k] - t) > std::abs(jump)) jump = range[k] - t;
+        }
+        if (std::abs(jump) > m.mixed_pixel_edge && unit(rng) < m.mixed_pixels) r += unit(rng) * jump;
+      }
       if (r > m.max_range || r <= 0.0) {
         if (options.keep_invalid) out.push_back(nan, nan, nan);
         continue;
       }
-      const Eigen::Vector3f p = (dir * r).cast<float>();
+      const Eigen::Vector3f p = (dirs[i] * r).cast<float>();
       out.push_back(p.x(), p.y(), p.z());
     }
   }
   return out;
+}
+
+ScannerModel scannerWithArtefacts() {
+  ScannerModel m;
+  m.dropout = 0.02;
+  m.mixed_pixels = 0.5;
+  return m;
+}
+
+void addNoReturnPatches(Scene& scene, std::mt19937_64& rng, int count) {
+  std::uniform_real_distribution<double> ux(-30.0, 160.0), uy(-30.0, 30.0), uz(-1.0, 4.0), ur(1.0, 4.0);
+  for (int k = 0; k < count; ++k) {
+    const Eigen::Vector3d c(ux(rng), uy(rng), uz(rng));
+    scene.no_return.push_back({c, ur(rng)});
+  }
 }
 
 PointArray scanInBody(const Scene& scene, const ScannerModel& model, const Eigen::Isometry3d& body,

@@ -32,7 +32,13 @@ namespace {
 
 void usage(std::ostream& os) {
   os << "usage: scene_benchmark [options]\n"
-        "  --scenes LIST         comma list of hall, urban, park, natural (default all)\n"
+        "  --scenes LIST         comma list of scene types: the paper's hall, urban, park,\n"
+        "                        natural (\"paper\", the default), and square, slope, forest,\n"
+        "                        tunnel, wall, crowd (\"robot\"); \"all\" for the ten\n"
+        "  --artefacts           the sensor's artefacts: 2 % dropouts, mixed pixels at half\n"
+        "                        the range edges, 30 no-return patches per world\n"
+        "  --sweep-interval S    [s] time between the two sweeps: what moves in crowd\n"
+        "                        (default 2)\n"
         "  --worlds N            worlds (scene seeds 1..N) per scene type (default 20)\n"
         "  --trials N            start poses per world and motion (default 10)\n"
         "  --motions LIST        table1 (the paper's Table 1 motion of the scene type),\n"
@@ -70,7 +76,7 @@ struct Row {
   Eigen::Matrix<double, 6, 1> error = Eigen::Matrix<double, 6, 1>::Zero();
   Eigen::Matrix<double, 6, 1> sigma = Eigen::Matrix<double, 6, 1>::Zero();
   bool degenerate = false;
-  double weak_ratio = 0.0;
+  double weak_ratio = 0.0, t_weak_ratio = 0.0;
   bool polished = false;
   double plane_rms = 0.0, plane_fraction = 0.0;
   int agreeing = 0, J_runner_up = 0, J_coarse = 0;
@@ -87,28 +93,11 @@ struct Row {
   bool accepted() const { return reason == GateReason::Accepted; }
 };
 
-/// True when `p` is inside (or within `margin` [m] of) a solid of the scene: no place for a
-/// scanner.
-bool insideSolid(const sim::Scene& scene, const Eigen::Vector3d& p, double margin) {
-  for (const sim::Box& b : scene.boxes) {
-    if ((p.array() >= b.lo.array() - margin).all() && (p.array() <= b.hi.array() + margin).all())
-      return true;
-  }
-  for (const sim::Cylinder& c : scene.cylinders) {
-    if (std::hypot(p.x() - c.cx, p.y() - c.cy) < c.r + margin && p.z() > c.z0 - margin &&
-        p.z() < c.z1 + margin)
-      return true;
-  }
-  for (const sim::Sphere& s : scene.spheres) {
-    if ((p - s.c).norm() < s.r + margin) return true;
-  }
-  return false;
-}
-
 /// A start pose on the scene's street (x in [0, 100] m, |y| <= 1 m, heading within +-10 deg,
-/// base 1 m above the ground) whose sensor and the sensor after `motion` are both in free space.
-Eigen::Isometry3d startPose(const sim::Scene& scene, const Eigen::Isometry3d& motion,
-                            std::mt19937_64& rng) {
+/// base 1 m above the ground) whose sensor is in free space in the first sweep's scene and the
+/// sensor after `motion` in the second's (they differ when things move).
+Eigen::Isometry3d startPose(const sim::Scene& scene, const sim::Scene& scene_b,
+                            const Eigen::Isometry3d& motion, std::mt19937_64& rng) {
   std::uniform_real_distribution<double> ux(0.0, 100.0), uy(-1.0, 1.0), uh(-10.0, 10.0);
   for (int attempt = 0; attempt < 200; ++attempt) {
     const double x = ux(rng), y = uy(rng);
@@ -116,13 +105,28 @@ Eigen::Isometry3d startPose(const sim::Scene& scene, const Eigen::Isometry3d& mo
     a.linear() = rotationFromRpy(0.0, 0.0, deg2rad(uh(rng)));
     a.translation() = Eigen::Vector3d(x, y, scene.groundHeight(x, y) + 1.0);
     const Eigen::Isometry3d b = a * motion;
-    if (!insideSolid(scene, a.translation(), 0.3) && !insideSolid(scene, b.translation(), 0.3))
+    if (!scene.insideSolid(a.translation(), 0.3) && !scene_b.insideSolid(b.translation(), 0.3))
       return a;
   }
   throw std::runtime_error("no free start pose found for this world and motion");
 }
 
 double median(const std::vector<double>& v) { return quantile(v, 0.5); }
+
+/// Scene names, with "paper", "robot" and "all" expanded; throws on an unknown name.
+std::vector<std::string> expandSceneList(const std::vector<std::string>& names) {
+  std::vector<std::string> out;
+  const auto& types = sim::allSceneTypes();
+  for (const std::string& n : names) {
+    if (n == "paper" || n == "robot" || n == "all") {
+      const std::size_t from = n == "robot" ? 4 : 0, to = n == "paper" ? 4 : types.size();
+      for (std::size_t k = from; k < to; ++k) out.push_back(sim::toString(types[k]));
+    } else {
+      out.push_back(sim::toString(sim::sceneTypeFromString(n)));
+    }
+  }
+  return out;
+}
 
 }  // namespace
 
@@ -137,6 +141,8 @@ int main(int argc, char** argv) {
   double check_success = -1, check_false_accepts = -1;
   int repeat = 1;
   double check_rep_m = -1, check_rep_deg = -1;
+  bool artefacts = false;
+  double sweep_interval = 2.0;
   RegistrationSettings settings;
   RangeFilterSettings filter;
   try {
@@ -144,9 +150,15 @@ int main(int argc, char** argv) {
       const std::string& a = args[i];
       if (a == "-h" || a == "--help") return usage(std::cout), 0;
       if (parseAlgorithmOption(args, i, settings, filter)) continue;
+      if (a == "--artefacts") {
+        artefacts = true;
+        ++i;
+        continue;
+      }
       if (i + 1 >= args.size()) throw std::invalid_argument(a + ": missing value or unknown option");
       const std::string v = args[i + 1];
-      if (a == "--scenes") scenes = splitList(v);
+      if (a == "--scenes") scenes = expandSceneList(splitList(v));
+      else if (a == "--sweep-interval") sweep_interval = io::parseNumber(a, v);
       else if (a == "--worlds") worlds = int(io::parseNumber(a, v));
       else if (a == "--trials") trials = int(io::parseNumber(a, v));
       else if (a == "--motions") motions = splitList(v);
@@ -169,6 +181,7 @@ int main(int argc, char** argv) {
       else throw std::invalid_argument("unknown option or value: " + a + " " + v);
       i += 2;
     }
+    if (!(sweep_interval >= 0.0)) throw std::invalid_argument("--sweep-interval must be >= 0");
     if (worlds < 1 || trials < 1) throw std::invalid_argument("--worlds and --trials must be >= 1");
     if (repeat < 1) throw std::invalid_argument("--repeat must be >= 1");
     if (check_rep_m >= 0 && repeat < 2)
@@ -176,7 +189,6 @@ int main(int argc, char** argv) {
     for (const std::string& m : motions) {
       if (m != "table1" && m != "random") throw std::invalid_argument("unknown motion: " + m);
     }
-    for (const std::string& s : scenes) sim::sceneTypeFromString(s);  // throws on a bad name
     validate(settings);
     validate(filter);
 
@@ -185,26 +197,32 @@ int main(int argc, char** argv) {
     csv << "scene,world,trial,motion,bounds,Es_m,Ea_deg,time_s,J,J_guess,J_truth,gate,success,"
            "ex_m,ey_m,ez_m,erx_rad,ery_rad,erz_rad,sx_m,sy_m,sz_m,srx_rad,sry_rad,srz_rad,"
            "degenerate,weak_ratio,polished,plane_rms_m,plane_fraction,"
-           "starts_agreeing,J_runner_up,J_coarse\n";
+           "starts_agreeing,J_runner_up,J_coarse,t_weak_ratio\n";
     CubeRegistration reg(settings);
     const GateSettings gate_settings;
-    const sim::ScannerModel model;
+    const sim::ScannerModel model = artefacts ? sim::scannerWithArtefacts() : sim::ScannerModel{};
     std::vector<Row> rows;
     // Per (scene, motion, bounds): each repeated pair's repeatability.
     std::map<std::tuple<std::string, std::string, std::string>, std::vector<Repeatability>> reps;
     for (const std::string& scene_name : scenes) {
       const sim::SceneType type = sim::sceneTypeFromString(scene_name);
       for (int w = 1; w <= worlds; ++w) {
-        const sim::Scene scene = sim::Scene::generate(type, std::uint64_t(w));
+        sim::Scene world = sim::Scene::generate(type, std::uint64_t(w));
         std::mt19937_64 rng(seed * 1000003ULL + std::uint64_t(w) * 7919ULL + std::uint64_t(type));
+        if (artefacts) {
+          std::mt19937_64 patch_rng(std::uint64_t(w) * 104729ULL + std::uint64_t(type));
+          sim::addNoReturnPatches(world, patch_rng, 30);
+        }
+        // The scenes of the two sweeps (equal unless something moves).
+        const sim::Scene scene = world.at(0.0), scene_b = world.at(sweep_interval);
         for (const std::string& motion_name : motions) {
           for (int t = 0; t < trials; ++t) {
             const Eigen::Isometry3d motion =
                 motion_name == "table1" ? sim::paperTable1Motion(type) : sim::randomPairMotion(rng);
-            const Eigen::Isometry3d a = startPose(scene, motion, rng), b = a * motion;
+            const Eigen::Isometry3d a = startPose(scene, scene_b, motion, rng), b = a * motion;
             // The reference is the first sweep, the scan the second: truth = T_a^-1 T_b.
             reg.setReference(filterPoints(sim::scanInBody(scene, model, a, rng), filter));
-            const PointArray scan = filterPoints(sim::scanInBody(scene, model, b, rng), filter);
+            const PointArray scan = filterPoints(sim::scanInBody(scene_b, model, b, rng), filter);
             const int j_truth = reg.score(scan, isometryToPose(motion));
             for (const Bounds& bd : bounds) {
               const Pose6 guess = isometryToPose(motion * sim::randomTransform(rng, bd.t, bd.a_deg));
@@ -219,6 +237,7 @@ int main(int argc, char** argv) {
               row.sigma = r.covariance.diagonal().cwiseMax(0.0).cwiseSqrt();
               row.degenerate = r.degenerate;
               row.weak_ratio = r.weak_ratio;
+              row.t_weak_ratio = r.translation_weak_ratio;
               row.polished = r.polished;
               row.plane_rms = r.plane_rms;
               row.agreeing = r.starts_agreeing;
@@ -234,7 +253,7 @@ int main(int argc, char** argv) {
               for (int k = 0; k < 6; ++k) csv << ',' << row.sigma(k);
               csv << ',' << int(row.degenerate) << ',' << row.weak_ratio << ',' << int(row.polished)
                   << ',' << row.plane_rms << ',' << row.plane_fraction << ',' << row.agreeing << ','
-                  << row.J_runner_up << ',' << row.J_coarse << '\n';
+                  << row.J_runner_up << ',' << row.J_coarse << ',' << row.t_weak_ratio << '\n';
               rows.push_back(row);
               if (repeat > 1) {
                 std::vector<Eigen::Isometry3d> estimates{r.transform};

@@ -33,7 +33,8 @@ namespace {
 
 void usage(std::ostream& os) {
   os << "usage: sequence_benchmark (--scene NAME | --dir DIR) [options]\n"
-        "  --scene NAME          simulated run: hall, urban, park or natural\n"
+        "  --scene NAME          simulated run: hall, urban, park, natural, square, slope,\n"
+        "                        forest, tunnel, wall or crowd (sim/scene.h)\n"
         "  --length M            simulated path length [m] (default 500)\n"
         "  --world-seed N        world, trajectory and noise seed (default 1; --seed is the\n"
         "                        GNMM's)\n"
@@ -278,7 +279,7 @@ int main(int argc, char** argv) {
         if (k > 0) robot->advance();
         pose = robot->pose();
         stamp = double(k) * period;
-        points = sim::scanInBody(*scene, model, pose, rng);
+        points = sim::scanInBody(scene->movers.empty() ? *scene : scene->at(stamp), model, pose, rng);
       } else {
         if (k == count) break;
         // Truth relative to the first pose: the estimate starts at the truth's first pose.

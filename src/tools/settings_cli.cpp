@@ -41,6 +41,12 @@ std::string algorithmOptionsHelp() {
          "  --polish-kernel K     Geman-McClure scale of the polish [m] (default " + num(d.polish.kernel) + ")\n"
          "  --polish-planarity P  a plane's smallest / middle eigenvalue at most P (default " + num(d.polish.max_planarity) + ")\n"
          "  --polish-min-points N reference points a plane needs (default " + std::to_string(d.polish.min_points) + ")\n"
+         "  --polish-min-spread F a plane's points spread >= F voxels along their second axis\n"
+         "                        (default " + num(d.polish.min_spread) + ")\n"
+         "  --support-cosine C    a plane informs a translation axis when its normal's cosine\n"
+         "                        to it is >= C (default " + num(d.polish.support_cosine) + ")\n"
+         "  --translation-degenerate R  degenerate when the weakest translation's supported\n"
+         "                        information is < R x the strongest's (default " + num(d.polish.translation_degenerate_ratio) + ")\n"
          "  --polish-collapse F   the polish evaluates one scan point per voxel of F*E, 0 = all\n"
          "                        (default " + num(d.polish.collapse_fraction) + ")\n"
          "  --polish-weak R       the polish does not move along directions with less than R x\n"
@@ -100,6 +106,12 @@ bool parseAlgorithmOption(const std::vector<std::string>& args, std::size_t& i,
     s.polish.max_planarity = value(1), used = 2;
   } else if (a == "--polish-min-points") {
     s.polish.min_points = int(value(1)), used = 2;
+  } else if (a == "--polish-min-spread") {
+    s.polish.min_spread = value(1), used = 2;
+  } else if (a == "--support-cosine") {
+    s.polish.support_cosine = value(1), used = 2;
+  } else if (a == "--translation-degenerate") {
+    s.polish.translation_degenerate_ratio = value(1), used = 2;
   } else if (a == "--polish-collapse") {
     s.polish.collapse_fraction = value(1), used = 2;
   } else if (a == "--polish-weak") {

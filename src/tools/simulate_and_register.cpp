@@ -30,7 +30,8 @@ int main(int argc, char** argv) {
       const std::string& a = args[i];
       if (a == "-h" || a == "--help") {
         std::cout << "usage: simulate_and_register [options]\n"
-                     "  --scene NAME          hall, urban, park or natural (default urban)\n"
+                     "  --scene NAME          hall, urban, park, natural, square, slope, forest, tunnel,\n"
+                     "                        wall or crowd (default urban; the crowd stands still)\n"
                      "  --sweeps N            sweeps to simulate (default 6)\n"
                      "  --odometry-error B    none, small (+-0.25 m, +-2 deg), big (+-1 m, +-8 deg)\n"
                      "                        uniform errors on each odometry increment, or drift\n"

@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <string>
 
 #include "cube_scan_matcher/core/pose.h"
 #include "cube_scan_matcher/sim/motion.h"
@@ -62,8 +63,10 @@ TEST(TiltingScanner, Eq1GeometryOnAWall) {
 }
 
 TEST(Scene, SameSeedSameWorld) {
-  for (const char* name : {"hall", "urban", "park", "natural"}) {
-    const auto t = sim::sceneTypeFromString(name);
+  ASSERT_EQ(sim::allSceneTypes().size(), 10u);
+  for (const sim::SceneType t : sim::allSceneTypes()) {
+    const std::string name = sim::toString(t);
+    EXPECT_EQ(sim::sceneTypeFromString(name), t);
     const sim::Scene a = sim::Scene::generate(t, 9), b = sim::Scene::generate(t, 9);
     EXPECT_EQ(a.boxes.size(), b.boxes.size());
     EXPECT_EQ(a.spheres.size(), b.spheres.size());
@@ -71,6 +74,69 @@ TEST(Scene, SameSeedSameWorld) {
     EXPECT_EQ(a.raycast(o, d, 81), b.raycast(o, d, 81)) << name;
   }
   EXPECT_THROW(sim::sceneTypeFromString("moon"), std::invalid_argument);
+}
+
+TEST(Scene, CrowdMovesBetweenSweepsAndTheRestStays) {
+  const sim::Scene world = sim::Scene::generate(sim::SceneType::Crowd, 3);
+  ASSERT_GT(world.movers.size(), 50u);
+  const sim::Scene a = world.at(0.0), b = world.at(2.0);
+  EXPECT_TRUE(a.movers.empty());
+  const std::size_t statics = world.boxes.size() + world.cylinders.size();
+  ASSERT_EQ(a.boxes.size() + a.cylinders.size(), statics + world.movers.size());
+  // The static primitives come first and are equal; every mover moved by |v| * 2 s.
+  for (std::size_t i = 0; i < world.boxes.size(); ++i) EXPECT_EQ(a.boxes[i].lo, b.boxes[i].lo);
+  std::size_t box = world.boxes.size(), cyl = world.cylinders.size();
+  for (const sim::Mover& m : world.movers) {
+    if (m.car) {
+      EXPECT_NEAR((b.boxes[box].lo - a.boxes[box].lo).norm(), 2.0 * m.v.norm(), 1e-9);
+      EXPECT_GE(m.v.norm(), 3.0);
+      ++box;
+    } else {
+      const double d = std::hypot(b.cylinders[cyl].cx - a.cylinders[cyl].cx, b.cylinders[cyl].cy - a.cylinders[cyl].cy);
+      EXPECT_NEAR(d, 2.0 * m.v.norm(), 1e-9);
+      ++cyl;
+    }
+  }
+  // The paper's worlds have no movers.
+  EXPECT_TRUE(sim::Scene::generate(sim::SceneType::Urban, 3).movers.empty());
+}
+
+TEST(TiltingScanner, ArtefactsDropBeamsMixEdgesAndNoReturnPatchesSwallowHits) {
+  // A box 10 m ahead in front of a wall 20 m ahead: along each 2D scan the range jumps at the
+  // box's edges.
+  sim::Scene scene;
+  scene.planes.push_back({Eigen::Vector3d(1, 0, 0), 20.0});
+  scene.boxes.push_back({Eigen::Vector3d(10, -2, -3), Eigen::Vector3d(11, 2, 3)});
+  Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();
+  pose.linear() = sim::sensorToBodyRotation();
+  sim::ScannerModel clean;
+  clean.range_noise = 0.0;
+  std::mt19937_64 rng(1);
+  const PointArray ref = sim::scan(scene, clean, pose, rng);
+  auto between = [](const PointArray& p) {  // points neither on the box's face nor the wall
+    int n = 0;
+    for (std::size_t i = 0; i < p.size(); ++i) n += p.y[i] > 10.05 && p.y[i] < 19.95;
+    return n;
+  };
+  EXPECT_EQ(between(ref), 0);
+  sim::ScannerModel art = clean;
+  art.mixed_pixels = 1.0;
+  art.dropout = 0.1;
+  const PointArray mixed = sim::scan(scene, art, pose, rng);
+  EXPECT_GT(between(mixed), 100);  // mixed pixels at the box's two edges, each 2D scan
+  EXPECT_LT(mixed.size(), 0.93 * ref.size());  // 10 % of the beams dropped
+  EXPECT_GT(mixed.size(), 0.87 * ref.size());
+  // A no-return patch over the box's face: none of its points return.
+  sim::Scene patched = scene;
+  patched.no_return.push_back({Eigen::Vector3d(10, 0, 0), 1.5});
+  const PointArray p = sim::scan(patched, clean, pose, rng);
+  for (std::size_t i = 0; i < p.size(); ++i) {
+    EXPECT_FALSE(std::abs(p.y[i] - 10.0) < 0.01 && std::hypot(p.x[i], p.z[i]) < 1.4);
+  }
+  EXPECT_LT(p.size(), ref.size());
+  // Defaults: no artefacts, so scans stay what they were.
+  EXPECT_EQ(sim::ScannerModel{}.dropout, 0.0);
+  EXPECT_EQ(sim::ScannerModel{}.mixed_pixels, 0.0);
 }
 
 TEST(SimMotion, StaysInTheSceneAndMovesLikeThePapersPairs) {

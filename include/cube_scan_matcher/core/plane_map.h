@@ -34,8 +34,13 @@ class PlaneMap {
   /// Sums the finite points of `reference` per voxel of edge `voxel` [m] (> 0). A block's plane
   /// is valid when it holds at least `min_points` points and is flat: smallest eigenvalue of
   /// the points' covariance <= max_planarity * the middle one (a line, e.g. one scan line
-  /// across the window, has both alike and is no plane).
-  PlaneMap(const PointArray& reference, double voxel, int min_points, double max_planarity);
+  /// across the window, has both alike and is no plane) and two-dimensional: its middle
+  /// spread (square root of the middle eigenvalue) at least min_spread * voxel. A patch of one
+  /// scan column seen at a grazing angle has the range noise, along the beam, as its second
+  /// spread, and its "normal" would be perpendicular to the beam, not to the surface (tilted
+  /// 18 deg along a tunnel's axis 15 m ahead: information the tunnel does not have).
+  PlaneMap(const PointArray& reference, double voxel, int min_points, double max_planarity,
+           double min_spread = 0.0);
   ~PlaneMap();
   PlaneMap(PlaneMap&&) noexcept;
   PlaneMap& operator=(PlaneMap&&) noexcept;
@@ -60,6 +65,7 @@ class PlaneMap {
   double voxel_ = 1.0;
   float inv_ = 1.0f;
   int min_points_ = 5;
+  double min_spread_ = 0.0;
   double max_planarity_ = 0.1;
   std::unique_ptr<detail::KeySet> keys_;
   std::vector<std::uint32_t> slot_to_index_;  // KeySet slot -> index into stats_

@@ -23,6 +23,9 @@ struct PolishSettings {
   double voxel_fraction = 0.5;
   int min_points = 6;           ///< reference points a plane needs, in [3, 1000].
   double max_planarity = 0.1;   ///< smallest / middle eigenvalue of a plane's points, (0, 1].
+  /// A plane's points spread at least this fraction of the voxel along their second axis (a
+  /// patch, not a scan column: PlaneMap). In [0, 1].
+  double min_spread = 0.25;
   /// Geman-McClure kernel: a residual r [m] weighs (k^2 / (k^2 + r^2))^2; residuals beyond one
   /// voxel are no correspondence. k in (0, 1] m.
   double kernel = 0.05;
@@ -42,16 +45,25 @@ struct PolishSettings {
   /// 1 rad = 1 m at the scan's radius of gyration) are not moved by the polish (numerically
   /// empty directions). In (0, 1).
   double weak_ratio = 1e-4;
-  /// The result is flagged degenerate when its weakest direction's information is below this
-  /// times the strongest one's (the simulated streets, halls, parks and hills give 3e-3 to
-  /// 3e-2). In (0, 1).
+  /// The result is flagged degenerate when its weakest direction's supported information (see
+  /// support_cosine) is below degenerate_ratio times the strongest one's, or the weakest
+  /// translation's (the normals alone, sum w n n^T) below translation_degenerate_ratio times
+  /// the strongest translation's. In (0, 1).
   double degenerate_ratio = 1e-3;
+  double translation_degenerate_ratio = 1e-2;
+  /// [m] The standard deviation a degenerate translation axis gets at least (nothing in the
+  /// scene fixes the pose along it). In [0, 1000].
+  double degenerate_sigma_m = 1.0;
   /// The covariance: sigma^2 (H)^-1 from the weighted residuals, times this factor. The raw
   /// least-squares covariance is too small (neighbouring residuals share a reference plane's
   /// error): on the scene benchmark (20 worlds of each type, seed 1, BENCHMARK.md) the 99th
   /// percentile of |error| / sd per axis asked for factors of 1.6-12.5 (hall x the largest);
   /// 12 keeps every axis within 3 sd in ~99 % of the accepted results. In [1, 1e6].
   double covariance_scale = 12.0;
+  /// A correspondence carries information along a translation axis only when its plane's
+  /// normal leans towards it by at least this cosine (0.15: 8.6 deg): the small random tilts
+  /// of fitted normals are not information. In [0, 1).
+  double support_cosine = 0.15;
 };
 
 /// Throws std::invalid_argument naming the bad setting (only when enabled).
@@ -73,6 +85,9 @@ struct PolishResult {
   /// radius of gyration), and its information relative to the strongest one.
   Eigen::Matrix<double, 6, 1> weak_direction = Eigen::Matrix<double, 6, 1>::Zero();
   double weak_ratio = 0.0;
+  /// The same for translation alone: the weakest supported axis [unit 3-vector] and ratio.
+  Eigen::Vector3d translation_weak_axis = Eigen::Vector3d::Zero();
+  double translation_weak_ratio = 0.0;
 };
 
 /// Polishes `pose` (scan -> reference, eq. 2) on `map` with the points of `scan`.

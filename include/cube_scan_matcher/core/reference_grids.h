@@ -23,6 +23,7 @@ struct PlaneMapSettings {
   double voxel = 0.25;  ///< [m]
   int min_points = 6;
   double max_planarity = 0.1;
+  double min_spread = 0.0;  ///< fraction of the voxel (PlaneMap)
 };
 
 /// Builds the E grid (`grid`), `fine_grids` fine grids of edge fine_edge_fraction * E with

@@ -105,6 +105,8 @@ struct RegistrationResult {
   bool degenerate = false;
   Eigen::Matrix<double, 6, 1> weak_direction = Eigen::Matrix<double, 6, 1>::Zero();
   double weak_ratio = 0.0;
+  Eigen::Vector3d translation_weak_axis = Eigen::Vector3d::Zero();
+  double translation_weak_ratio = 0.0;
   int evaluations_refine = 0;     ///< of `evaluations`, those of the refine stage.
   std::string message;            ///< human-readable summary or reason of failure.
 

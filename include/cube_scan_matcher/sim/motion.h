@@ -50,7 +50,8 @@ Eigen::Isometry3d randomTransform(std::mt19937_64& rng, double t, double a_deg);
 /// [alpha, beta, gamma] about Z, Y, X composed as Rz(alpha) Ry(beta) Rx(gamma) (eq. 2); the
 /// simulator's frame is the paper's turned by -90 deg about Z (M), so the motion is
 /// M T_paper M^T: translation (y0, -x0, z0), yaw alpha, roll beta, pitch -gamma. Hall uses
-/// the indoor row.
+/// the indoor row; the scene types beyond the paper's use the row of the nearest kind: tunnel
+/// indoor, square, wall and crowd urban, forest park, slope natural.
 Eigen::Isometry3d paperTable1Motion(SceneType type);
 
 /// A random forward motion between two sweeps, T_first_second: travel uniform in [1, 5] m

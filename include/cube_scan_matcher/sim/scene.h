@@ -25,10 +25,26 @@ struct Sphere {
   double r;
 };
 
-enum class SceneType { Hall, Urban, Park, Natural };
-/// "hall", "urban", "park", "natural"; throws std::invalid_argument otherwise.
+/// The paper's four scene types (section 3.2), then six that robots meet beyond them (issue 12):
+///  - square: an open paved square, a few small objects, facades 55-75 m away (little structure);
+///  - slope: steep (7 deg) rough terrain, bumps and rocks, few upright surfaces;
+///  - forest: dense vegetation, hundreds of thin trunks and bushes of small spheres;
+///  - tunnel: a straight featureless tunnel, 11 m wide and 6 m high (degenerate along x);
+///  - wall: a long wall 3-4 m to the left filling half the view, an open field on the right;
+///  - crowd: a street whose people and cars move between two sweeps (Scene::movers).
+enum class SceneType { Hall, Urban, Park, Natural, Square, Slope, Forest, Tunnel, Wall, Crowd };
+/// Every type, the paper's four first.
+const std::vector<SceneType>& allSceneTypes();
+/// A type's name as above; throws std::invalid_argument for an unknown one.
 SceneType sceneTypeFromString(const std::string& name);
 std::string toString(SceneType type);
+
+/// A person (vertical cylinder, 0.25 m radius, 1.7 m tall) or a car (axis-aligned 4.5 x 1.8 x
+/// 1.5 m box) at p0 (x, y on the ground, z of the ground) at t = 0, moving at v [m/s].
+struct Mover {
+  bool car = false;
+  Eigen::Vector3d p0 = Eigen::Vector3d::Zero(), v = Eigen::Vector3d::Zero();
+};
 
 class Scene {
  public:
@@ -36,13 +52,25 @@ class Scene {
   std::vector<Box> boxes;
   std::vector<Cylinder> cylinders;
   std::vector<Sphere> spheres;
+  /// Objects that move: raycast() ignores them; at(t) turns them into primitives.
+  std::vector<Mover> movers;
+  /// No-return patches (dark or specular surfaces): a surface point inside one of these spheres
+  /// gives no return. Empty unless added (addNoReturnPatches, a sensor artefact).
+  std::vector<Sphere> no_return;
 
   /// Seeded procedural scene like the paper's four (section 3.2): equal seeds, equal worlds.
   /// The robot drives along +x from the origin, so content is laid out around that path.
   static Scene generate(SceneType type, std::uint64_t seed);
 
+  /// The scene at time t [s]: the movers become cylinders and boxes at p0 + v t.
+  Scene at(double t) const;
+
+  /// True when p is inside (or within margin [m] of) a solid: no place for a scanner.
+  bool insideSolid(const Eigen::Vector3d& p, double margin) const;
+
   /// Distance along the unit direction `dir` from `origin` to the first surface, or a
-  /// negative value if the ray hits nothing within max_range.
+  /// negative value if the ray hits nothing within max_range. A hit inside a no_return sphere
+  /// counts as no hit.
   double raycast(const Eigen::Vector3d& origin, const Eigen::Vector3d& dir, double max_range) const;
 
   /// Height of the ground below (x, y) (for placing the robot), from the planes only.

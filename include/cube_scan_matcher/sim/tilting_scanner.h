@@ -20,6 +20,12 @@ struct ScannerModel {
   double psi_min_deg = -30.0, psi_max_deg = 30.0, psi_step_deg = 1.0 / 3.0;
   double max_range = 81.0;    ///< [m] beams beyond it (or with no return) give no point
   double range_noise = 0.04;  ///< [m] uniform +-noise added to every range
+  /// Sensor artefacts (0 = off, the defaults): the probability that a beam gives no return,
+  /// and that a beam at a range edge (a neighbour in its 2D scan more than mixed_pixel_edge
+  /// [m] nearer or farther) returns a mixed pixel, a range uniform between the two surfaces.
+  double dropout = 0.0;
+  double mixed_pixels = 0.0;
+  double mixed_pixel_edge = 0.3;
   int phiCount() const;       ///< beams per 2D scan (361 by default)
   int psiCount() const;       ///< 2D scans per sweep (181 by default)
 };
@@ -33,6 +39,13 @@ struct SweepOptions {
   /// false: beams without a return are dropped.
   bool keep_invalid = false;
 };
+
+/// The paper's sensor with its artefacts on: 2 % dropouts, mixed pixels at half the edges.
+ScannerModel scannerWithArtefacts();
+
+/// Adds `count` no-return patches (Scene::no_return: dark or specular surfaces, puddles) of
+/// 1-4 m radius, centred within x [-30, 160] m, |y| <= 30 m, z [-1, 4] m.
+void addNoReturnPatches(Scene& scene, std::mt19937_64& rng, int count);
 
 /// Casts every beam of one sweep from `sensor_pose` (sensor frame of eq. 1 -> world) and
 /// returns the points in the sensor frame.
