@@ -13,6 +13,7 @@ namespace cube_scan_matcher {
 void validate(const SearchSettings& s) {
   requireInRange("search starts", s.starts, 1, 64);
   requireInRange("search threads", s.threads, 1, 64);
+  requireInRange("search retries", s.retries, 0, 8);
 }
 
 CoarseSearchResult coarseSearch(const std::vector<CoincidenceObjective*>& objectives,

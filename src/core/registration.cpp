@@ -186,7 +186,7 @@ int CubeRegistration::score(const PointArray& scan, const Pose6& pose) const {
   return j;
 }
 
-void CubeRegistration::coarseStage(const ScanPoints& points, const Pose6& guess,
+void CubeRegistration::coarseStage(const ScanPoints& points, const Pose6& guess, int attempt,
                                    RegistrationResult& res, std::vector<Pose6>& ranked,
                                    std::vector<int>& ranked_J) const {
   std::vector<CoincidenceObjective*> objectives;
@@ -194,7 +194,9 @@ void CubeRegistration::coarseStage(const ScanPoints& points, const Pose6& guess,
     w->coarse.setScan(*points.coarse);
     objectives.push_back(&w->coarse);
   }
-  const CoarseSearchResult c = coarseSearch(objectives, settings_.gnmm, settings_.search, guess);
+  GnmmSettings gnmm = settings_.gnmm;
+  gnmm.seed += std::uint64_t(attempt) * std::uint64_t(settings_.search.starts);
+  const CoarseSearchResult c = coarseSearch(objectives, gnmm, settings_.search, guess);
   res.pose = c.runs.front().best;
   res.J = res.J_coarse = int(c.runs.front().best_value);
   res.J_guess = c.J_guess;
@@ -248,6 +250,41 @@ void CubeRegistration::polishStage(const ScanPoints& points, RegistrationResult&
   res.translation_weak_ratio = p.translation_weak_ratio;
 }
 
+void CubeRegistration::searchAttempt(const ScanPoints& points, const Pose6& guess, int attempt,
+                                     RegistrationResult& res, std::vector<Pose6>& ranked,
+                                     std::vector<int>& ranked_J) const {
+  using Clock = std::chrono::steady_clock;
+  auto seconds = [](Clock::time_point a, Clock::time_point b) {
+    return std::chrono::duration<double>(b - a).count();
+  };
+  const RefineSettings& rs = settings_.refine;
+  // Coarse search: GNMM starts on the E grid.
+  const auto coarse_start = Clock::now();
+  coarseStage(points, guess, attempt, res, ranked, ranked_J);
+  const auto coarse_end = Clock::now();
+  res.time_coarse_s = seconds(coarse_start, coarse_end);
+
+  // Refine (not in the paper): compass search on the fine grids from the coarse results.
+  if (rs.enabled && res.J > 0 && !reference_->fine.empty()) {
+    refineStage(points, ranked, res);
+    res.time_refine_s = seconds(coarse_end, Clock::now());
+  }
+
+  // Polish (not in the paper): point-to-plane Gauss-Newton from the cube result, and the
+  // covariance.
+  if (settings_.polish.enabled && res.J > 0 && reference_->planes.voxels() > 0) {
+    const auto polish_start = Clock::now();
+    polishStage(points, res);
+    res.time_polish_s = seconds(polish_start, Clock::now());
+  }
+  if (res.J > 0 && (rs.enabled || res.polished)) {
+    // J on the E grid at the result, on all points collapsed as for the coarse stage.
+    CoincidenceObjective& objective = workspaces_[0]->coarse;
+    objective.setScan(*points.full);
+    res.J = objective(res.pose);
+  }
+}
+
 RegistrationResult CubeRegistration::align(const PointArray& scan, const Pose6& guess) const {
   using Clock = std::chrono::steady_clock;
   const auto start = Clock::now();
@@ -284,33 +321,33 @@ RegistrationResult CubeRegistration::align(const PointArray& scan, const Pose6& 
   prepareScan(scan, points);
   res.points_used = points.coarse->size();
 
-  // 2. Coarse search: GNMM starts on the E grid.
-  std::vector<Pose6> ranked;  // the starts' results, by decreasing J
+  // 2-4. Coarse search, refine, polish; again from new seeds while the result is not
+  // confirmed (SearchSettings::retries).
+  std::vector<Pose6> ranked;  // the chosen attempt's starts' results, by decreasing J
   std::vector<int> ranked_J;  // and their J
-  const auto coarse_start = Clock::now();
-  coarseStage(points, guess, res, ranked, ranked_J);
-  const auto coarse_end = Clock::now();
-  res.time_coarse_s = seconds(coarse_start, coarse_end);
-
-  // 3. Refine (not in the paper): compass search on the fine grids from the coarse results.
-  if (rs.enabled && res.J > 0 && !reference_->fine.empty()) {
-    refineStage(points, ranked, res);
-    res.time_refine_s = seconds(coarse_end, Clock::now());
+  const RegistrationResult before = res;
+  double time_coarse = 0.0, time_refine = 0.0, time_polish = 0.0;
+  int evaluations = 0, iterations = 0, restarts = 0, attempts = 0;
+  for (int attempt = 0; attempt <= ss.retries; ++attempt) {
+    RegistrationResult r = before;
+    std::vector<Pose6> r_ranked;
+    std::vector<int> r_ranked_J;
+    searchAttempt(points, guess, attempt, r, r_ranked, r_ranked_J);
+    ++attempts;
+    time_coarse += r.time_coarse_s, time_refine += r.time_refine_s, time_polish += r.time_polish_s;
+    evaluations += r.evaluations, iterations += r.iterations, restarts += r.restarts;
+    const bool confirmed = !r.polish_tried || (r.polished && !r.degenerate);
+    if (attempt == 0 || confirmed) {
+      res = r;
+      res.attempt_used = attempt;
+      ranked = std::move(r_ranked);
+      ranked_J = std::move(r_ranked_J);
+    }
+    if (confirmed) break;
   }
-
-  // 4. Polish (not in the paper): point-to-plane Gauss-Newton from the cube result, and the
-  // covariance.
-  if (settings_.polish.enabled && res.J > 0 && reference_->planes.voxels() > 0) {
-    const auto polish_start = Clock::now();
-    polishStage(points, res);
-    res.time_polish_s = seconds(polish_start, Clock::now());
-  }
-  if (res.J > 0 && (rs.enabled || res.polished)) {
-    // J on the E grid at the result, on all points collapsed as for the coarse stage.
-    CoincidenceObjective& objective = workspaces_[0]->coarse;
-    objective.setScan(*points.full);
-    res.J = objective(res.pose);
-  }
+  res.attempts = attempts;
+  res.time_coarse_s = time_coarse, res.time_refine_s = time_refine, res.time_polish_s = time_polish;
+  res.evaluations = evaluations, res.iterations = iterations, res.restarts = restarts;
 
   // 5. Agreement of the starts with the result (ambiguity, for the acceptance gate).
   for (std::size_t k = 0; k < ranked.size(); ++k) {

@@ -349,6 +349,7 @@ OnlineStep ScanMatcherNodelet::registerScan(Scan& scan) {
   status.plane_rms = r.plane_rms;
   status.degenerate = r.degenerate;
   status.weak_ratio = r.weak_ratio;
+  status.translation_weak_ratio = r.translation_weak_ratio;
   for (int k = 0; k < 6; ++k) {
     status.sigma[std::size_t(k)] = std::sqrt(std::max(0.0, r.covariance(k, k)));
     status.weak_direction[std::size_t(k)] = r.weak_direction(k);

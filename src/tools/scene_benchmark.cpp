@@ -79,7 +79,7 @@ struct Row {
   double weak_ratio = 0.0, t_weak_ratio = 0.0;
   bool polished = false;
   double plane_rms = 0.0, plane_fraction = 0.0;
-  int agreeing = 0, J_runner_up = 0, J_coarse = 0;
+  int agreeing = 0, J_runner_up = 0, J_coarse = 0, attempts = 1;
   /// The largest |error| / sigma over the six axes (0 without a covariance).
   double maxZ() const {
     double z = 0.0;
@@ -197,7 +197,7 @@ int main(int argc, char** argv) {
     csv << "scene,world,trial,motion,bounds,Es_m,Ea_deg,time_s,J,J_guess,J_truth,gate,success,"
            "ex_m,ey_m,ez_m,erx_rad,ery_rad,erz_rad,sx_m,sy_m,sz_m,srx_rad,sry_rad,srz_rad,"
            "degenerate,weak_ratio,polished,plane_rms_m,plane_fraction,"
-           "starts_agreeing,J_runner_up,J_coarse,t_weak_ratio\n";
+           "starts_agreeing,J_runner_up,J_coarse,t_weak_ratio,attempts\n";
     CubeRegistration reg(settings);
     const GateSettings gate_settings;
     const sim::ScannerModel model = artefacts ? sim::scannerWithArtefacts() : sim::ScannerModel{};
@@ -238,6 +238,7 @@ int main(int argc, char** argv) {
               row.degenerate = r.degenerate;
               row.weak_ratio = r.weak_ratio;
               row.t_weak_ratio = r.translation_weak_ratio;
+              row.attempts = r.attempts;
               row.polished = r.polished;
               row.plane_rms = r.plane_rms;
               row.agreeing = r.starts_agreeing;
@@ -253,7 +254,8 @@ int main(int argc, char** argv) {
               for (int k = 0; k < 6; ++k) csv << ',' << row.sigma(k);
               csv << ',' << int(row.degenerate) << ',' << row.weak_ratio << ',' << int(row.polished)
                   << ',' << row.plane_rms << ',' << row.plane_fraction << ',' << row.agreeing << ','
-                  << row.J_runner_up << ',' << row.J_coarse << ',' << row.t_weak_ratio << '\n';
+                  << row.J_runner_up << ',' << row.J_coarse << ',' << row.t_weak_ratio << ','
+                  << row.attempts << '\n';
               rows.push_back(row);
               if (repeat > 1) {
                 std::vector<Eigen::Isometry3d> estimates{r.transform};

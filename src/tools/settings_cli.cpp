@@ -24,6 +24,8 @@ std::string algorithmOptionsHelp() {
          "                        (default " + num(d.gnmm.bounds[0]) + " m, " + num(rad2deg(d.gnmm.bounds[3])) + " deg)\n"
          "  --starts K            independent GNMM searches from the guess, best J wins\n"
          "                        (default " + std::to_string(d.search.starts) + "; paper 1)\n"
+         "  --retries N           search again from new seeds while the polished result is\n"
+         "                        degenerate or unconfirmed, up to N times (default " + std::to_string(d.search.retries) + ")\n"
          "  --threads T           threads for the starts, the refine candidates and the grid\n"
          "                        builds (default " + std::to_string(d.search.threads) + ")\n"
          "  --collapse F          keep one scan point per voxel of F*E before the search,\n"
@@ -136,6 +138,8 @@ bool parseAlgorithmOption(const std::vector<std::string>& args, std::size_t& i,
     used = 3;
   } else if (a == "--starts") {
     s.search.starts = int(value(1)), used = 2;
+  } else if (a == "--retries") {
+    s.search.retries = int(value(1)), used = 2;
   } else if (a == "--threads") {
     s.search.threads = int(value(1)), used = 2;
   } else if (a == "--dense-points") {

@@ -363,5 +363,15 @@ TEST(Registration, ATunnelIsFlaggedDegenerateAlongItsAxisAndRejected) {
     const Eigen::Vector3d across = r.transform.translation() - motion.translation();
     EXPECT_LT((across - across.dot(axis) * axis).norm(), 0.05);
     EXPECT_EQ(gate(r, guess, GateSettings{}), GateReason::Degenerate);
+    // Degenerate: the search ran again from new seeds (SearchSettings::retries), in vain.
+    EXPECT_EQ(r.attempts, 2);
+    EXPECT_EQ(r.attempt_used, 0);
   }
+  // A confirmed result is not searched again.
+  const Scans s = makeScans(sim::SceneType::Urban, 3);
+  CubeRegistration urban{RegistrationSettings{}};
+  urban.setReference(s.first);
+  const RegistrationResult u = urban.align(s.second, isometryToPose(s.T_first_second));
+  EXPECT_TRUE(u.polished && !u.degenerate);
+  EXPECT_EQ(u.attempts, 1);
 }

@@ -20,6 +20,14 @@ struct SearchSettings {
   /// Threads the starts (and the refine candidates and the grid builds) run on; start k runs
   /// on thread k % threads, and each thread owns a working copy of every grid. In [1, 64].
   int threads = 2;
+  /// Beyond the paper: when the polished result is not confirmed (the polish found too few
+  /// planes or left the basin, or flags it degenerate: the wrong poses the search lands on
+  /// from big starts are, a hall slid along its aisle), the search (coarse, refine, polish)
+  /// runs again from new seeds (gnmm.seed + starts * attempt + k), up to `retries` more times;
+  /// the first confirmed result wins, else the first one. No retry without the polish (the
+  /// paper's mode) or when the first result is confirmed. A scene that is degenerate
+  /// (a tunnel) pays every retry. In [0, 8].
+  int retries = 1;
 };
 
 /// Throws std::invalid_argument naming the bad setting.

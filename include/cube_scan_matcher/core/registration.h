@@ -81,6 +81,10 @@ struct RegistrationResult {
   int iterations = 0;              ///< GNMM iterations, all runs.
   int restarts = 0;                ///< GNMM restarts, all runs.
   int J_coarse = 0;  ///< J at E after the first stage, on its points (dense_points filter).
+  /// Searches run (1 + the retries that ran: SearchSettings::retries) and the one the result
+  /// comes from (0 = the first).
+  int attempts = 1;
+  int attempt_used = 0;
   /// Ambiguity: the coarse starts whose result lies within 0.25 m / 2 deg of the final pose,
   /// and the highest coarse J of the others (0 when every start agrees).
   int starts_agreeing = 0;
@@ -154,11 +158,16 @@ class CubeRegistration {
   void prepareWorkspaces(int count) const;
   /// The steps of align(), under the mutex.
   void prepareScan(const PointArray& scan, ScanPoints& points) const;
-  void coarseStage(const ScanPoints& points, const Pose6& guess, RegistrationResult& res,
-                   std::vector<Pose6>& ranked, std::vector<int>& ranked_J) const;
+  void coarseStage(const ScanPoints& points, const Pose6& guess, int attempt,
+                   RegistrationResult& res, std::vector<Pose6>& ranked,
+                   std::vector<int>& ranked_J) const;
   void refineStage(const ScanPoints& points, const std::vector<Pose6>& ranked,
                    RegistrationResult& res) const;
   void polishStage(const ScanPoints& points, RegistrationResult& res) const;
+  /// Coarse, refine and polish stages from the seeds of `attempt` (0 = the first).
+  void searchAttempt(const ScanPoints& points, const Pose6& guess, int attempt,
+                     RegistrationResult& res, std::vector<Pose6>& ranked,
+                     std::vector<int>& ranked_J) const;
   /// Unbinds every objective from this call's points.
   void releaseScan() const;
 
