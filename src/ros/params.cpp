@@ -36,6 +36,7 @@ void configToSettings(const ScanMatcherConfig& c, OnlineMatcherSettings& m) {
   r.gnmm.bounds << c.bounds_translation, c.bounds_translation, c.bounds_translation, a, a, a;
   r.gnmm.seed = std::uint64_t(c.seed);
   r.search.starts = c.starts;
+  r.search.retries = c.retries;
   r.search.threads = c.threads;
   r.collapse_fraction = c.collapse_fraction;
   r.dense_points = c.dense_points;
@@ -115,6 +116,7 @@ ScanMatcherConfig toConfig(const NodeParams& p) {
   c.bounds_rotation = rad2deg(r.gnmm.bounds[3]);
   c.seed = int(r.gnmm.seed);
   c.starts = r.search.starts;
+  c.retries = r.search.retries;
   c.threads = r.search.threads;
   c.collapse_fraction = r.collapse_fraction;
   c.dense_points = r.dense_points;

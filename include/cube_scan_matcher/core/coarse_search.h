@@ -27,7 +27,7 @@ struct SearchSettings {
   /// the first confirmed result wins, else the first one. No retry without the polish (the
   /// paper's mode) or when the first result is confirmed. A scene that is degenerate
   /// (a tunnel) pays every retry. In [0, 8].
-  int retries = 1;
+  int retries = 2;
 };
 
 /// Throws std::invalid_argument naming the bad setting.
