@@ -49,15 +49,15 @@ struct Linearisation {
   int count = 0;
 };
 
-/// One correspondence's Jacobian row and weight.
+/// One correspondence's plane normal and weight (its Jacobian's translation part).
 struct Row {
-  Vector6 J;
+  Eigen::Vector3d n;
   double w;
 };
 
 /// With `near`, also collects the scan points that found a plane (the only ones the later
 /// iterations need to look at: the pose moves by millimetres); with `rows`, every
-/// correspondence's Jacobian row and weight.
+/// correspondence's normal and weight.
 Linearisation linearise(const PlaneMap& map, const PointArray& scan, const Eigen::Matrix3d& R,
                         const Eigen::Vector3d& t, double kernel, PointArray* near = nullptr,
                         std::vector<Row>* rows = nullptr) {
@@ -78,7 +78,7 @@ Linearisation linearise(const PlaneMap& map, const PointArray& scan, const Eigen
     J.head<3>() = plane->normal;
     J.tail<3>() = rp.cross(plane->normal);
     L.H.selfadjointView<Eigen::Upper>().rankUpdate(J, w);
-    if (rows) rows->push_back({J, w});
+    if (rows) rows->push_back({plane->normal, w});
     L.g.noalias() += (w * r) * J;
     L.weight += w;
     L.weighted_r2 += w * r * r;
@@ -212,13 +212,11 @@ PolishResult polishOnPlanes(const PlaneMap& map, const PointArray& scan, const P
   // only from the planes that lean towards each by support_cosine. In a tunnel the fitted
   // normals' small tilts (and a few fits across a corner) would otherwise give its axis 0.3-2 %
   // of the floor's information, a 1-2 cm sd and a wrong pose accepted 1-2 m along the axis.
-  Eigen::Matrix3d Ht = Eigen::Matrix3d::Zero();
-  for (const Row& row : rows) Ht.noalias() += row.w * row.J.head<3>() * row.J.head<3>().transpose();
-  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> et(Ht);
+  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> et(L.H.topLeftCorner<3, 3>());
   Eigen::Vector3d t_info = Eigen::Vector3d::Zero();
   for (const Row& row : rows) {
     for (int k = 0; k < 3; ++k) {
-      const double c = row.J.head<3>().dot(et.eigenvectors().col(k));
+      const double c = row.n.dot(et.eigenvectors().col(k));
       if (std::abs(c) >= s.support_cosine) t_info(k) += row.w * c * c;
     }
   }
@@ -229,21 +227,17 @@ PolishResult polishOnPlanes(const PlaneMap& map, const PointArray& scan, const P
   const Eigen::Vector3d u = et.eigenvectors().col(t_weakest);
   res.translation_weak_axis = u;
   res.translation_weak_ratio = t_info.maxCoeff() > 0.0 ? t_info(t_weakest) / t_info.maxCoeff() : 0.0;
-  // Along that axis the variance is at least what the supported information gives.
-  const double t_floor = std::max(t_info.maxCoeff() * 1e-12, 1e-300);
-  const double supported_var = s.covariance_scale * sigma2 / std::max(t_info(t_weakest), t_floor);
-  const double var_u = u.dot(res.covariance.topLeftCorner<3, 3>() * u);
-  if (supported_var > var_u) {
-    res.covariance.topLeftCorner<3, 3>() += (supported_var - var_u) * u * u.transpose();
-  }
+  // Along that axis the variance is at least what the supported information gives, and when
+  // nothing fixes the pose along it (the cube stages leave it near the guess, whose error the
+  // scan cannot tell) at least degenerate_sigma_m^2.
   const bool translation_degenerate = res.translation_weak_ratio < s.translation_degenerate_ratio;
-  if (translation_degenerate) {
-    // Nothing fixes the pose along u: the scan cannot tell its error there (the cube stages
-    // leave it near the guess), so its sd is degenerate_sigma_m at least.
-    const double floor_var = s.degenerate_sigma_m * s.degenerate_sigma_m;
-    const double now = u.dot(res.covariance.topLeftCorner<3, 3>() * u);
-    if (floor_var > now) res.covariance.topLeftCorner<3, 3>() += (floor_var - now) * u * u.transpose();
-    if (res.weak_ratio >= s.degenerate_ratio) res.weak_direction << u, 0.0, 0.0, 0.0;
+  const double t_floor = std::max(t_info.maxCoeff() * 1e-12, 1e-300);
+  double min_var = s.covariance_scale * sigma2 / std::max(t_info(t_weakest), t_floor);
+  if (translation_degenerate) min_var = std::max(min_var, s.degenerate_sigma_m * s.degenerate_sigma_m);
+  const double var_u = u.dot(res.covariance.topLeftCorner<3, 3>() * u);
+  if (min_var > var_u) res.covariance.topLeftCorner<3, 3>() += (min_var - var_u) * u * u.transpose();
+  if (translation_degenerate && res.weak_ratio >= s.degenerate_ratio) {
+    res.weak_direction << u, 0.0, 0.0, 0.0;  // the axis the scene does not fix
   }
   res.degenerate = res.weak_ratio < s.degenerate_ratio || translation_degenerate;
   return res;

@@ -19,6 +19,11 @@ namespace {
 /// A start agrees with the result when its coarse pose is this close [m], [rad].
 constexpr double kAgreeTranslation = 0.25;
 constexpr double kAgreeRotation = 0.03490658503988659;  // 2 deg
+
+using Clock = std::chrono::steady_clock;
+double seconds(Clock::time_point a, Clock::time_point b) {
+  return std::chrono::duration<double>(b - a).count();
+}
 }  // namespace
 
 RegistrationSettings RegistrationSettings::paper(double cube_edge) {
@@ -253,10 +258,6 @@ void CubeRegistration::polishStage(const ScanPoints& points, RegistrationResult&
 void CubeRegistration::searchAttempt(const ScanPoints& points, const Pose6& guess, int attempt,
                                      RegistrationResult& res, std::vector<Pose6>& ranked,
                                      std::vector<int>& ranked_J) const {
-  using Clock = std::chrono::steady_clock;
-  auto seconds = [](Clock::time_point a, Clock::time_point b) {
-    return std::chrono::duration<double>(b - a).count();
-  };
   const RefineSettings& rs = settings_.refine;
   // Coarse search: GNMM starts on the E grid.
   const auto coarse_start = Clock::now();
@@ -286,11 +287,7 @@ void CubeRegistration::searchAttempt(const ScanPoints& points, const Pose6& gues
 }
 
 RegistrationResult CubeRegistration::align(const PointArray& scan, const Pose6& guess) const {
-  using Clock = std::chrono::steady_clock;
   const auto start = Clock::now();
-  auto seconds = [](Clock::time_point a, Clock::time_point b) {
-    return std::chrono::duration<double>(b - a).count();
-  };
   RegistrationResult res;
   res.points_in = scan.size();
   res.pose = guess;

@@ -119,7 +119,8 @@ std::vector<std::string> expandSceneList(const std::vector<std::string>& names) 
   const auto& types = sim::allSceneTypes();
   for (const std::string& n : names) {
     if (n == "paper" || n == "robot" || n == "all") {
-      const std::size_t from = n == "robot" ? 4 : 0, to = n == "paper" ? 4 : types.size();
+      const std::size_t from = n == "robot" ? sim::kPaperSceneTypes : 0;
+      const std::size_t to = n == "paper" ? sim::kPaperSceneTypes : types.size();
       for (std::size_t k = from; k < to; ++k) out.push_back(sim::toString(types[k]));
     } else {
       out.push_back(sim::toString(sim::sceneTypeFromString(n)));

@@ -45,10 +45,10 @@ struct PolishSettings {
   /// 1 rad = 1 m at the scan's radius of gyration) are not moved by the polish (numerically
   /// empty directions). In (0, 1).
   double weak_ratio = 1e-4;
-  /// The result is flagged degenerate when its weakest direction's supported information (see
-  /// support_cosine) is below degenerate_ratio times the strongest one's, or the weakest
-  /// translation's (the normals alone, sum w n n^T) below translation_degenerate_ratio times
-  /// the strongest translation's. In (0, 1).
+  /// The result is flagged degenerate when its weakest direction's information is below
+  /// degenerate_ratio times the strongest one's, or the weakest translation's supported
+  /// information (the normals alone, sum w n n^T, see support_cosine) below
+  /// translation_degenerate_ratio times the strongest translation's. In (0, 1).
   double degenerate_ratio = 1e-3;
   double translation_degenerate_ratio = 1e-2;
   /// [m] The standard deviation a degenerate translation axis gets at least (nothing in the

@@ -2,6 +2,7 @@
 // exact truth (no external data). World frame: x forward, y left, z up, metres.
 #pragma once
 
+#include <cstddef>
 #include <cstdint>
 #include <string>
 #include <vector>
@@ -33,8 +34,9 @@ struct Sphere {
 ///  - wall: a long wall 3-4 m to the left filling half the view, an open field on the right;
 ///  - crowd: a street whose people and cars move between two sweeps (Scene::movers).
 enum class SceneType { Hall, Urban, Park, Natural, Square, Slope, Forest, Tunnel, Wall, Crowd };
-/// Every type, the paper's four first.
+/// Every type, the paper's four first (kPaperSceneTypes of them).
 const std::vector<SceneType>& allSceneTypes();
+constexpr std::size_t kPaperSceneTypes = 4;
 /// A type's name as above; throws std::invalid_argument for an unknown one.
 SceneType sceneTypeFromString(const std::string& name);
 std::string toString(SceneType type);
