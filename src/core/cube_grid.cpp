@@ -1,9 +1,14 @@
 #include "cube_scan_matcher/core/cube_grid.h"
 
 #include <algorithm>
+#include <atomic>
 #include <cmath>
+#include <cstdio>
+#include <cstdlib>
 #include <limits>
 #include <sstream>
+
+#include "cube_scan_matcher/core/simd_path.h"
 
 namespace cube_scan_matcher {
 
@@ -45,19 +50,17 @@ GridAffine CubeGrid::affine(const Eigen::Matrix3f& rotation,
   return makeAffine(rotation, translation, min_, edge_);
 }
 
-// The hot loop. Cloned for AVX-512/AVX2 and dispatched at load time on CPU *features* (an
-// "arch=" clone would dispatch on the Intel model name and miss AMD CPUs); `omp simd` (with
-// -fopenmp-simd, no OpenMP runtime) makes GCC vectorise it at -O2. Clones exist only for x86:
-// elsewhere (aarch64: NEON is the baseline) the one portable version is compiled.
-#if defined(__x86_64__) && defined(__GNUC__) && !defined(CSM_NO_TARGET_CLONES)
-#define CSM_X86_CLONES __attribute__((target_clones("default", "avx2", "avx512f")))
-#else
-#define CSM_X86_CLONES
-#endif
-CSM_X86_CLONES
-void computeCubeIndices(const GridAffine& g, const Eigen::Vector3f& dims, const float* x,
-                        const float* y, const float* z, std::size_t n, std::int32_t outside,
-                        std::int32_t* idx) {
+// The hot loop. The body is written once, inlined into one function per instruction set
+// (x86-64: AVX-512F, AVX2 and the baseline; elsewhere, e.g. aarch64 with NEON as its
+// baseline, only the baseline) and picked through simd_path.h. `omp simd` (with
+// -fopenmp-simd, no OpenMP runtime) makes GCC vectorise each copy at -O2. This file is built
+// with -ffp-contract=off (CMakeLists.txt): no copy fuses a multiply and an add into an FMA
+// (the AVX-512 one did, AVX-512F having FMA of its own), so every copy rounds the same
+// multiplies and adds and the indices are identical on every path (test_cube_grid.cpp).
+namespace {
+inline __attribute__((always_inline)) void cubeIndicesBody(
+    const GridAffine& g, const Eigen::Vector3f& dims, const float* x, const float* y,
+    const float* z, std::size_t n, std::int32_t outside, std::int32_t* idx) {
   const float nx = dims.x(), ny = dims.y(), nz = dims.z();
   // Unsigned arithmetic: the index of a clamped outside point may wrap (it is discarded), an
   // inside index is < v <= 2^31 and fits an int32.
@@ -80,6 +83,133 @@ void computeCubeIndices(const GridAffine& g, const Eigen::Vector3f& dims, const 
     const std::uint32_t iz = std::uint32_t(std::int32_t(std::min(std::max(0.f, az), nz)));
     idx[i] = inside ? std::int32_t(ix + iy * sx + iz * sxy) : outside;
   }
+}
+
+using IndexKernel = void (*)(const GridAffine&, const Eigen::Vector3f&, const float*,
+                             const float*, const float*, std::size_t, std::int32_t,
+                             std::int32_t*);
+
+void cubeIndicesPortable(const GridAffine& g, const Eigen::Vector3f& dims, const float* x,
+                         const float* y, const float* z, std::size_t n, std::int32_t outside,
+                         std::int32_t* idx) {
+  cubeIndicesBody(g, dims, x, y, z, n, outside, idx);
+}
+
+#if defined(__x86_64__) && defined(__GNUC__) && !defined(CSM_NO_X86_PATHS)
+#define CSM_HAVE_X86_PATHS 1
+__attribute__((target("avx2"))) void cubeIndicesAvx2(
+    const GridAffine& g, const Eigen::Vector3f& dims, const float* x, const float* y,
+    const float* z, std::size_t n, std::int32_t outside, std::int32_t* idx) {
+  cubeIndicesBody(g, dims, x, y, z, n, outside, idx);
+}
+__attribute__((target("avx512f"))) void cubeIndicesAvx512(
+    const GridAffine& g, const Eigen::Vector3f& dims, const float* x, const float* y,
+    const float* z, std::size_t n, std::int32_t outside, std::int32_t* idx) {
+  cubeIndicesBody(g, dims, x, y, z, n, outside, idx);
+}
+#endif
+
+IndexKernel kernelFor(SimdPath path) {
+#ifdef CSM_HAVE_X86_PATHS
+  if (path == SimdPath::Avx512) return cubeIndicesAvx512;
+  if (path == SimdPath::Avx2) return cubeIndicesAvx2;
+#endif
+  (void)path;
+  return cubeIndicesPortable;
+}
+
+SimdPath bestSupported() { return supportedSimdPaths().front(); }
+
+// The path on first use: CSM_SIMD if it names a path this CPU runs, else the best.
+SimdPath initialPath() {
+  const SimdPath best = bestSupported();
+  const char* env = std::getenv("CSM_SIMD");
+  if (!env || !*env) return best;
+  try {
+    const std::optional<SimdPath> want = parseSimdPath(env);
+    if (!want) return best;
+    if (simdPathSupported(*want)) return *want;
+    std::fprintf(stderr, "cube_scan_matcher: CSM_SIMD=%s: this CPU or build cannot run it; using %s\n",
+                 env, simdPathName(best));
+  } catch (const std::invalid_argument& e) {
+    std::fprintf(stderr, "cube_scan_matcher: CSM_SIMD: %s; using %s\n", e.what(),
+                 simdPathName(best));
+  }
+  return best;
+}
+
+struct Dispatch {
+  explicit Dispatch(SimdPath p) : path(p), kernel(kernelFor(p)) {}
+  std::atomic<SimdPath> path;
+  std::atomic<IndexKernel> kernel;
+};
+
+Dispatch& dispatch() {
+  static Dispatch d(initialPath());
+  return d;
+}
+}  // namespace
+
+const char* simdPathName(SimdPath path) {
+  switch (path) {
+    case SimdPath::Avx512: return "avx512";
+    case SimdPath::Avx2: return "avx2";
+    case SimdPath::Portable: break;
+  }
+  return "portable";
+}
+
+std::optional<SimdPath> parseSimdPath(const std::string& name) {
+  if (name == "auto") return std::nullopt;
+  for (SimdPath p : {SimdPath::Avx512, SimdPath::Avx2, SimdPath::Portable}) {
+    if (name == simdPathName(p)) return p;
+  }
+  throw std::invalid_argument("unknown SIMD path '" + name +
+                              "' (expected auto, avx512, avx2 or portable)");
+}
+
+bool simdPathSupported(SimdPath path) {
+  if (path == SimdPath::Portable) return true;
+#ifdef CSM_HAVE_X86_PATHS
+  __builtin_cpu_init();
+  if (path == SimdPath::Avx512) return __builtin_cpu_supports("avx512f");
+  if (path == SimdPath::Avx2) return __builtin_cpu_supports("avx2");
+#endif
+  return false;
+}
+
+std::vector<SimdPath> supportedSimdPaths() {
+  std::vector<SimdPath> out;
+  for (SimdPath p : {SimdPath::Avx512, SimdPath::Avx2, SimdPath::Portable}) {
+    if (simdPathSupported(p)) out.push_back(p);
+  }
+  return out;
+}
+
+SimdPath activeSimdPath() { return dispatch().path.load(std::memory_order_relaxed); }
+
+void setSimdPath(std::optional<SimdPath> path) {
+  const SimdPath p = path ? *path : bestSupported();
+  if (!simdPathSupported(p)) {
+    throw std::invalid_argument(std::string("SIMD path ") + simdPathName(p) +
+                                " is not supported by this CPU or build");
+  }
+  Dispatch& d = dispatch();
+  d.kernel.store(kernelFor(p), std::memory_order_relaxed);
+  d.path.store(p, std::memory_order_relaxed);
+}
+
+std::string simdReport() {
+  std::string s = simdPathName(activeSimdPath());
+  s += " (supported here:";
+  for (SimdPath p : supportedSimdPaths()) s += std::string(" ") + simdPathName(p);
+  return s + ")";
+}
+
+void computeCubeIndices(const GridAffine& g, const Eigen::Vector3f& dims, const float* x,
+                        const float* y, const float* z, std::size_t n, std::int32_t outside,
+                        std::int32_t* idx) {
+  dispatch().kernel.load(std::memory_order_relaxed)(g, dims, x, y, z, n, outside, idx);
 }
 
 CubeGrid CubeGrid::build(const PointArray& ref, const CubeGridSettings& settings) {

@@ -15,6 +15,7 @@
 #include "cube_scan_matcher/Status.h"
 #include "cube_scan_matcher/core/filters.h"
 #include "cube_scan_matcher/core/metrics.h"
+#include "cube_scan_matcher/core/simd_path.h"
 #include "cube_scan_matcher/ros/cloud_conversion.h"
 #include "cube_scan_matcher/ros/transforms.h"
 
@@ -94,10 +95,12 @@ void ScanMatcherNodelet::onInit() {
   // Subscribe last: callbacks may start at once.
   cloud_sub_ = nh.subscribe("cloud", std::uint32_t(params_.queue_size),
                             &ScanMatcherNodelet::cloudCallback, this);
-  NODELET_INFO("ScanMatcherNodelet: registering %s in %s (odometry %s, poses in %s), E = %.2f m",
-               cloud_sub_.getTopic().c_str(), params_.base_frame.c_str(),
-               params_.odom_frame.c_str(), params_.map_frame.c_str(),
-               params_.matcher.registration.grid.cube_edge);
+  NODELET_INFO(
+      "ScanMatcherNodelet: registering %s in %s (odometry %s, poses in %s), E = %.2f m, "
+      "SIMD path %s",
+      cloud_sub_.getTopic().c_str(), params_.base_frame.c_str(), params_.odom_frame.c_str(),
+      params_.map_frame.c_str(), params_.matcher.registration.grid.cube_edge,
+      simdReport().c_str());
 }
 
 void ScanMatcherNodelet::reconfigure(ScanMatcherConfig& config, uint32_t /*level*/) {

@@ -305,6 +305,7 @@ int main(int argc, char** argv) {
     }
 
     // Summary: median Es, Ea, time, successes; time ratio to the first cube method.
+    std::printf("%s\n", machineReport().c_str());
     std::printf("\n%-44s %-6s %-22s %9s %9s %10s %8s %10s %16s\n", "pair", "bounds", "method",
                 "med Es[m]", "med Ea[°]", "med t[s]", "success", "t/t_cube", "rep [m]|[°]");
     bool require_ok = true;

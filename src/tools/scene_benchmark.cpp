@@ -274,6 +274,7 @@ int main(int argc, char** argv) {
     }
 
     // Per (scene, motion, bounds) group.
+    std::printf("%s\n", machineReport().c_str());
     std::printf("%-8s %-7s %-6s %9s %22s %22s %9s %5s %5s %5s %6s %14s %15s\n", "scene", "motion", "bounds",
                 "success", "Es med|p95|max [m]", "Ea med|p95|max [deg]", "median s", "acc",
                 "FA", "FR", ">3sd", "sd_t|sd_r", repeat > 1 ? "rep [m]|[deg]" : "");

@@ -318,6 +318,7 @@ int main(int argc, char** argv) {
       }
     }
     const StationaryDrift still_truth = stationaryDrift(truth, truth);
+    std::printf("%s\n", machineReport().c_str());
     std::printf("%s, odometry %s: %zu scans, %.1f m, %d standing-still runs (%d scans)\n",
                 label.c_str(), odometry_mode.c_str(), truth.size(), travelled,
                 still_truth.segments, still_truth.scans);

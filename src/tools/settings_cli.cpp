@@ -1,8 +1,11 @@
 #include "settings_cli.h"
 
 #include <cstdlib>
+#include <fstream>
 #include <sstream>
 #include <stdexcept>
+
+#include "cube_scan_matcher/core/simd_path.h"
 
 
 namespace cube_scan_matcher::tools {
@@ -28,6 +31,10 @@ std::string algorithmOptionsHelp() {
          "                        degenerate or unconfirmed, up to N times (default " + std::to_string(d.search.retries) + ")\n"
          "  --threads T           threads for the starts, the refine candidates and the grid\n"
          "                        builds (default " + std::to_string(d.search.threads) + ")\n"
+         "  --simd P              vector path of the per-point loop: auto, avx512, avx2 or\n"
+         "                        portable (default auto = the fastest this CPU runs, or the\n"
+         "                        CSM_SIMD environment variable); results are the same on all\n"
+         "                        paths\n"
          "  --collapse F          keep one scan point per voxel of F*E before the search,\n"
          "                        0 = all points as in the paper (default " + num(d.collapse_fraction) + ")\n"
          "  --refine F            compass-search stage on cubes of F*E from the coarse result,\n"
@@ -73,6 +80,19 @@ std::string algorithmOptionsHelp() {
          "  --max-range R         drop points farther than R [m] (default none)\n"
          "  --paper               the paper's fixed mode: 15 vertices, 500 iterations, all points,\n"
          "                        restarts around the initial estimate (resets the options before it)\n";
+}
+
+std::string machineReport() {
+  std::string model = "unknown";
+  std::ifstream in("/proc/cpuinfo");
+  for (std::string line; std::getline(in, line);) {
+    // x86: "model name : ..."; aarch64 kernels print no model name, only "CPU part".
+    if (line.rfind("model name", 0) == 0 && line.find(':') != std::string::npos) {
+      model = line.substr(line.find(':') + 2);
+      break;
+    }
+  }
+  return "CPU: " + model + "; SIMD path: " + simdReport();
 }
 
 bool parseAlgorithmOption(const std::vector<std::string>& args, std::size_t& i,
@@ -140,6 +160,9 @@ bool parseAlgorithmOption(const std::vector<std::string>& args, std::size_t& i,
     s.search.starts = int(value(1)), used = 2;
   } else if (a == "--retries") {
     s.search.retries = int(value(1)), used = 2;
+  } else if (a == "--simd") {
+    setSimdPath(parseSimdPath(word(1)));
+    used = 2;
   } else if (a == "--threads") {
     s.search.threads = int(value(1)), used = 2;
   } else if (a == "--dense-points") {

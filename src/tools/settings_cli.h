@@ -18,6 +18,10 @@ std::string algorithmOptionsHelp();
 bool parseAlgorithmOption(const std::vector<std::string>& args, std::size_t& i,
                           RegistrationSettings& settings, RangeFilterSettings& filter);
 
+/// One header line for benchmark output: the CPU model (from /proc/cpuinfo where it exists)
+/// and the SIMD path the per-point loop runs on, so that every quoted time says which ran.
+std::string machineReport();
+
 /// "a,b,,c" -> {"a", "b", "c"} (empty items dropped).
 std::vector<std::string> splitList(const std::string& s);
 

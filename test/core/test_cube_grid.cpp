@@ -1,10 +1,14 @@
 // CubeGrid: V and L of eqs. 3-6, the inclusive upper bound, the memory guard, bad settings.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
+#include <random>
+#include <vector>
 
 #include "cube_scan_matcher/core/cube_grid.h"
+#include "cube_scan_matcher/core/simd_path.h"
 #include "grid_test_helpers.h"
 
 using namespace cube_scan_matcher;
@@ -109,4 +113,83 @@ TEST(CubeGrid, SettingsOutOfRangeAreRefusedByName) {
   } catch (const std::invalid_argument& e) {
     EXPECT_NE(std::string(e.what()).find("max_cubes"), std::string::npos);
   }
+}
+
+namespace {
+// Restores the automatic SIMD path when a test that forces one ends.
+struct SimdPathGuard {
+  ~SimdPathGuard() { setSimdPath(std::nullopt); }
+};
+}  // namespace
+
+TEST(SimdPath, EveryPathGivesTheIndicesOfThePortableOne) {
+  // Random rotations and translations, points inside, outside, on cube faces (x.5 after the
+  // affine's +0.5) and non-finite: every vector path must write the same indices.
+  SimdPathGuard guard;
+  const std::vector<SimdPath> paths = supportedSimdPaths();
+  ASSERT_FALSE(paths.empty());
+  EXPECT_EQ(paths.back(), SimdPath::Portable);
+  PointArray ref;
+  ref.push_back(-20, -15, -3);
+  ref.push_back(25, 30, 8);
+  const CubeGrid g = CubeGrid::build(ref, edge(0.5));
+  std::mt19937_64 rng(7);
+  std::uniform_real_distribution<float> u(-30.f, 35.f);
+  // Not a multiple of any vector width; enough points that a rounding difference (an FMA on
+  // one path only) moves some index across a face.
+  const std::size_t n = 400009;
+  std::vector<float> x(n), y(n), z(n);
+  for (std::size_t i = 0; i < n; ++i) {
+    x[i] = u(rng), y[i] = u(rng), z[i] = u(rng) / 3;
+    // (k + 0.25 + 20) / 0.5 + 0.5 is an integer: on a cube face under the identity (trial 0).
+    if (i % 97 == 0) x[i] = std::round(x[i]) + 0.25f;
+    if (i % 101 == 0) y[i] = std::numeric_limits<float>::quiet_NaN();
+    if (i % 103 == 0) z[i] = -std::numeric_limits<float>::infinity();
+  }
+  for (int trial = 0; trial < 20; ++trial) {
+    Pose6 p = Pose6::Zero();
+    if (trial > 0) {
+      for (int k = 0; k < 6; ++k) p[k] = std::uniform_real_distribution<double>(-1, 1)(rng);
+    }
+    const Eigen::Isometry3d t = poseToIsometry(p);
+    const GridAffine a = g.affine(t.linear().cast<float>(), t.translation().cast<float>());
+    setSimdPath(SimdPath::Portable);
+    EXPECT_EQ(activeSimdPath(), SimdPath::Portable);
+    std::vector<std::int32_t> want(n), got(n);
+    computeCubeIndices(a, g.dimsF(), x.data(), y.data(), z.data(), n, -7, want.data());
+    EXPECT_GT(std::count_if(want.begin(), want.end(), [](std::int32_t i) { return i >= 0; }),
+              std::ptrdiff_t(n / 10));  // a real share of the points is inside
+    for (SimdPath path : paths) {
+      setSimdPath(path);
+      EXPECT_EQ(activeSimdPath(), path);
+      computeCubeIndices(a, g.dimsF(), x.data(), y.data(), z.data(), n, -7, got.data());
+      std::size_t differ = 0;
+      for (std::size_t i = 0; i < n; ++i) differ += got[i] != want[i];
+      EXPECT_EQ(differ, 0u) << simdPathName(path) << " trial " << trial;
+    }
+  }
+}
+
+TEST(SimdPath, NamesParseAndBadOnesAreRefused) {
+  SimdPathGuard guard;
+  for (SimdPath p : {SimdPath::Avx512, SimdPath::Avx2, SimdPath::Portable}) {
+    EXPECT_EQ(parseSimdPath(simdPathName(p)), p);
+  }
+  EXPECT_EQ(parseSimdPath("auto"), std::nullopt);
+  try {
+    parseSimdPath("avx3");
+    FAIL() << "avx3 was accepted";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("avx3"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("portable"), std::string::npos) << e.what();
+  }
+  // The automatic choice is the fastest supported path; an unsupported one is refused.
+  setSimdPath(std::nullopt);
+  EXPECT_EQ(activeSimdPath(), supportedSimdPaths().front());
+  for (SimdPath p : {SimdPath::Avx512, SimdPath::Avx2}) {
+    if (!simdPathSupported(p)) {
+      EXPECT_THROW(setSimdPath(p), std::invalid_argument);
+    }
+  }
+  EXPECT_NE(simdReport().find(simdPathName(activeSimdPath())), std::string::npos);
 }

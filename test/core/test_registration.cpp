@@ -6,6 +6,7 @@
 #include <cstdio>
 #include <algorithm>
 #include <limits>
+#include <optional>
 #include <random>
 #include <string>
 #include <tuple>
@@ -13,7 +14,9 @@
 #include <vector>
 
 #include "cube_scan_matcher/core/acceptance_gate.h"
+#include "cube_scan_matcher/core/metrics.h"
 #include "cube_scan_matcher/core/registration.h"
+#include "cube_scan_matcher/core/simd_path.h"
 #include "cube_scan_matcher/sim/tilting_scanner.h"
 
 using namespace cube_scan_matcher;
@@ -217,6 +220,33 @@ TEST(Registration, AReusedMatcherGivesTheResultsOfAFreshOne) {
     EXPECT_TRUE(r.pose.isApprox(f.pose, 1e-12)) << k;
   }
   EXPECT_EQ(reused.score(a.second, ra.pose), ra.J);
+}
+
+TEST(Registration, EverySimdPathGivesTheSameResult) {
+  // The vector paths compute the same indices, so a whole registration (search, refine,
+  // polish, covariance) must come out bit-identical on each.
+  const Scans a = makeScans(sim::SceneType::Urban, 5);
+  Pose6 guess = isometryToPose(a.T_first_second);
+  guess[1] -= 0.5;
+  guess[5] += deg2rad(4);
+  CubeRegistration reg(RegistrationSettings{});
+  reg.setReference(a.first);
+  std::optional<RegistrationResult> want;
+  for (SimdPath path : supportedSimdPaths()) {
+    setSimdPath(path);
+    const RegistrationResult r = reg.align(a.second, guess);
+    if (!want) {
+      want = r;
+      continue;
+    }
+    EXPECT_EQ(r.J, want->J) << simdPathName(path);
+    EXPECT_EQ(r.evaluations, want->evaluations) << simdPathName(path);
+    EXPECT_EQ(r.pose, want->pose) << simdPathName(path);
+    EXPECT_EQ(r.covariance, want->covariance) << simdPathName(path);
+  }
+  setSimdPath(std::nullopt);
+  ASSERT_TRUE(want.has_value());
+  EXPECT_TRUE(poseError(poseToIsometry(want->pose), a.T_first_second).success());
 }
 
 TEST(Registration, ConcurrentAlignCallsGiveTheSequentialResults) {
