@@ -95,7 +95,7 @@ void cubeIndicesPortable(const GridAffine& g, const Eigen::Vector3f& dims, const
   cubeIndicesBody(g, dims, x, y, z, n, outside, idx);
 }
 
-#if defined(__x86_64__) && defined(__GNUC__) && !defined(CSM_NO_X86_PATHS)
+#if defined(__x86_64__) && defined(__GNUC__)
 #define CSM_HAVE_X86_PATHS 1
 __attribute__((target("avx2"))) void cubeIndicesAvx2(
     const GridAffine& g, const Eigen::Vector3f& dims, const float* x, const float* y,
@@ -118,6 +118,9 @@ IndexKernel kernelFor(SimdPath path) {
   return cubeIndicesPortable;
 }
 
+/// Every path, fastest first.
+constexpr SimdPath kAllPaths[] = {SimdPath::Avx512, SimdPath::Avx2, SimdPath::Portable};
+
 SimdPath bestSupported() { return supportedSimdPaths().front(); }
 
 // The path on first use: CSM_SIMD if it names a path this CPU runs, else the best.
@@ -138,15 +141,10 @@ SimdPath initialPath() {
   return best;
 }
 
-struct Dispatch {
-  explicit Dispatch(SimdPath p) : path(p), kernel(kernelFor(p)) {}
-  std::atomic<SimdPath> path;
-  std::atomic<IndexKernel> kernel;
-};
-
-Dispatch& dispatch() {
-  static Dispatch d(initialPath());
-  return d;
+/// The active path; its kernel is looked up once per block of points (kernelFor).
+std::atomic<SimdPath>& activePath() {
+  static std::atomic<SimdPath> path(initialPath());
+  return path;
 }
 }  // namespace
 
@@ -161,7 +159,7 @@ const char* simdPathName(SimdPath path) {
 
 std::optional<SimdPath> parseSimdPath(const std::string& name) {
   if (name == "auto") return std::nullopt;
-  for (SimdPath p : {SimdPath::Avx512, SimdPath::Avx2, SimdPath::Portable}) {
+  for (SimdPath p : kAllPaths) {
     if (name == simdPathName(p)) return p;
   }
   throw std::invalid_argument("unknown SIMD path '" + name +
@@ -180,13 +178,13 @@ bool simdPathSupported(SimdPath path) {
 
 std::vector<SimdPath> supportedSimdPaths() {
   std::vector<SimdPath> out;
-  for (SimdPath p : {SimdPath::Avx512, SimdPath::Avx2, SimdPath::Portable}) {
+  for (SimdPath p : kAllPaths) {
     if (simdPathSupported(p)) out.push_back(p);
   }
   return out;
 }
 
-SimdPath activeSimdPath() { return dispatch().path.load(std::memory_order_relaxed); }
+SimdPath activeSimdPath() { return activePath().load(std::memory_order_relaxed); }
 
 void setSimdPath(std::optional<SimdPath> path) {
   const SimdPath p = path ? *path : bestSupported();
@@ -194,9 +192,7 @@ void setSimdPath(std::optional<SimdPath> path) {
     throw std::invalid_argument(std::string("SIMD path ") + simdPathName(p) +
                                 " is not supported by this CPU or build");
   }
-  Dispatch& d = dispatch();
-  d.kernel.store(kernelFor(p), std::memory_order_relaxed);
-  d.path.store(p, std::memory_order_relaxed);
+  activePath().store(p, std::memory_order_relaxed);
 }
 
 std::string simdReport() {
@@ -209,7 +205,7 @@ std::string simdReport() {
 void computeCubeIndices(const GridAffine& g, const Eigen::Vector3f& dims, const float* x,
                         const float* y, const float* z, std::size_t n, std::int32_t outside,
                         std::int32_t* idx) {
-  dispatch().kernel.load(std::memory_order_relaxed)(g, dims, x, y, z, n, outside, idx);
+  kernelFor(activeSimdPath())(g, dims, x, y, z, n, outside, idx);
 }
 
 CubeGrid CubeGrid::build(const PointArray& ref, const CubeGridSettings& settings) {

@@ -25,15 +25,11 @@ using namespace cube_scan_matcher::tools;
 
 namespace {
 
-/// A scanner whose sweep of `scene` from `body` holds about `target` points: the default
-/// model's phi and psi steps divided by sqrt(target / default count).
-sim::ScannerModel scaledScanner(const sim::Scene& scene, const Eigen::Isometry3d& body,
-                                std::size_t target) {
+/// A scanner whose sweep holds about `target` points where the default model's sweep holds
+/// `default_points`: the default phi and psi steps divided by sqrt(target / default_points).
+sim::ScannerModel scaledScanner(std::size_t default_points, std::size_t target) {
   sim::ScannerModel model;
-  std::mt19937_64 rng(1);
-  const double have = double(sim::scanInBody(scene, model, body, rng).size());
-  if (have < 1.0) throw std::runtime_error("the default sweep of this scene has no points");
-  const double f = std::sqrt(double(target) / have);
+  const double f = std::sqrt(double(target) / double(default_points));
   model.phi_step_deg /= f;
   model.psi_step_deg /= f;
   return model;
@@ -102,6 +98,10 @@ int main(int argc, char** argv) {
     motion.linear() = rotationFromRpy(0.0, 0.0, deg2rad(8.0));
     motion.translation() = Eigen::Vector3d(2.0, 0.3, 0.0);
     const Eigen::Isometry3d b = a * motion;
+    // The default sweep's size, counted once: every target scales from it.
+    std::mt19937_64 count_rng(1);
+    const std::size_t default_points = sim::scanInBody(scene, sim::ScannerModel{}, a, count_rng).size();
+    if (default_points == 0) throw std::runtime_error("the default sweep of this scene has no points");
 
     std::printf("%s\n", machineReport().c_str());
     std::printf("scene %s (seed %llu), %d trials per size, guesses within +-1 m / +-8 deg\n",
@@ -117,7 +117,7 @@ int main(int argc, char** argv) {
     CubeRegistration reg(settings);
     int short_sizes = 0;
     for (std::size_t target : sizes) {
-      const sim::ScannerModel model = scaledScanner(scene, a, target);
+      const sim::ScannerModel model = scaledScanner(default_points, target);
       std::mt19937_64 rng(seed * 7919 + target);
       const PointArray ref = filterPoints(sim::scanInBody(scene, model, a, rng), filter);
       const PointArray scan = filterPoints(sim::scanInBody(scene, model, b, rng), filter);
