@@ -6,6 +6,7 @@
 #include <stdexcept>
 #include <vector>
 
+#include "cube_scan_matcher/core/deskew.h"
 #include "require_in_range.h"
 
 namespace cube_scan_matcher {
@@ -23,6 +24,7 @@ void validate(const OnlineMatcherSettings& s) {
   requireInRange("keyframe interval [s]", k.interval, 0.0, 1e6);
   requireInRange("submap size [keyframes]", k.submap_size, 1, 20);
   requireInRange("no_odometry_scale", s.no_odometry_scale, 1.0, 10.0);
+  requireInRange("deskew iterations", s.deskew.iterations, 0, 10);
 }
 
 OnlineMatcher::OnlineMatcher(const OnlineMatcherSettings& settings)
@@ -103,9 +105,51 @@ double OnlineMatcher::gateScale(double stamp, double since) const {
   return std::clamp(std::round((stamp - since) / period), 1.0, kMaxGateScale);
 }
 
-OnlineStep OnlineMatcher::process(const PointArray& points, double stamp,
-                                  const std::optional<Eigen::Isometry3d>& odom) {
+void OnlineMatcher::deskewScan(OnlineStep& step, const PointArray& points,
+                               const std::vector<float>& times, double interval,
+                               const std::optional<Eigen::Isometry3d>& odom, const Keyframe& keyframe,
+                               const GateSettings& gate_settings, std::optional<PointArray>& out) {
+  // The motion since the last known scan: as placed (odometry at both ends, else none) and as
+  // registered (anchor * increment, anchor = T_prev_keyframe); constant velocity over the
+  // interval (core/deskew.h).
+  const Eigen::Isometry3d placed = odom && last_known_->odom
+                                       ? last_known_->odom->inverse() * *odom
+                                       : Eigen::Isometry3d::Identity();
+  const Eigen::Isometry3d anchor = last_known_->pose.inverse() * keyframe.pose;
+  for (int round = 0; round < settings_.deskew.iterations; ++round) {
+    // The pose at which every line lies on the reference (plane_polish.h), then a full
+    // registration of the sweep re-placed there: the result the gate judges.
+    const SweepPolishResult sp = registration_.polishSweep(points, times, interval, placed, anchor,
+                                                           step.result.pose, 20);
+    if (!sp.applied) break;
+    out = points;
+    deskew(*out, times, interval, placed, anchor * poseToIsometry(sp.pose));
+    RegistrationResult again = registration_.align(*out, sp.pose);
+    if (!again.ok() || gate(again, step.guess, gate_settings) != GateReason::Accepted) break;
+    const Eigen::Isometry3d change = step.increment.inverse() * again.transform;
+    step.result = std::move(again);
+    step.increment = step.result.transform;
+    step.correction = correctionFromGuess(step.guess, step.result.pose);
+    ++step.reregistered;
+    if (change.translation().norm() < 1e-3 && Eigen::AngleAxisd(change.linear()).angle() < 1.745e-4) break;
+  }
+  // The keyframe's points: re-placed with the final motion (from the scan as given).
+  out = points;
+  deskew(*out, times, interval, placed, anchor * step.increment);
+  step.deskewed = true;
+}
+
+OnlineStep OnlineMatcher::process(const PointArray& scan_points, double stamp,
+                                  const std::optional<Eigen::Isometry3d>& odom,
+                                  const std::vector<float>* times) {
+  if (times && times->size() != scan_points.size()) {
+    throw std::invalid_argument("process: " + std::to_string(times->size()) + " point times for " +
+                                std::to_string(scan_points.size()) + " points");
+  }
   OnlineStep step;
+  // The scan's points, re-placed below when de-skewed (a copy only then).
+  std::optional<PointArray> deskewed;
+  const PointArray* points_ptr = &scan_points;
   if (last_stamp_ && stamp < *last_stamp_) {
     // The scan period is the sensor's: it survives a bag loop or a clock reset.
     std::deque<double> intervals = std::move(intervals_);
@@ -139,9 +183,9 @@ OnlineStep OnlineMatcher::process(const PointArray& points, double stamp,
   step.guess = isometryToPose(step.increment);
 
   if (first) {
-    step.reason = points.empty() ? GateReason::BadInput : GateReason::FirstScan;
+    step.reason = scan_points.empty() ? GateReason::BadInput : GateReason::FirstScan;
     step.pose = predicted;
-  } else if (points.empty()) {
+  } else if (scan_points.empty()) {
     step.reason = GateReason::BadInput;
   } else {
     step.registered = true;
@@ -152,14 +196,14 @@ OnlineStep OnlineMatcher::process(const PointArray& points, double stamp,
     RegistrationSettings wide = settings_.registration;
     wide.gnmm.bounds *= step.gate_scale;
     if (step.gate_scale > 1.0) registration_.setSettings(wide);
-    step.result = registration_.align(points, step.guess);
+    step.result = registration_.align(scan_points, step.guess);
     if (!step.odometry_guess && settings_.constant_velocity && settings_.no_motion_candidate &&
         last_known_) {
       // Constant velocity fails where the motion changes most (a turn on the spot that starts,
       // stops or reverses): the no-motion guess is searched too, and the higher J wins.
       const Pose6 still = isometryToPose(keyframe->pose.inverse() * last_known_->pose);
       if ((still - step.guess).norm() > 1e-6) {
-        RegistrationResult other = registration_.align(points, still);
+        RegistrationResult other = registration_.align(scan_points, still);
         if (other.ok() && (!step.result.ok() || other.J > step.result.J)) {
           step.result = std::move(other);
           step.guess = still;
@@ -174,8 +218,13 @@ OnlineStep OnlineMatcher::process(const PointArray& points, double stamp,
     if (step.result.ok()) step.correction = correctionFromGuess(step.guess, step.result.pose);
     step.accepted = step.reason == GateReason::Accepted;
     if (step.accepted) step.increment = step.result.transform;
+    if (step.accepted && times && settings_.deskew.enabled && last_known_ && stamp > last_known_->stamp) {
+      deskewScan(step, scan_points, *times, stamp - last_known_->stamp, odom, *keyframe, gate_settings, deskewed);
+      points_ptr = &*deskewed;
+    }
   }
   if (keyframe) step.pose = keyframe->pose * step.increment;
+  const PointArray& points = *points_ptr;
 
   const bool rejected = !first && !step.accepted;
   consecutive_rejections_ = rejected ? consecutive_rejections_ + 1 : 0;

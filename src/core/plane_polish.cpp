@@ -7,6 +7,7 @@
 #include <Eigen/Eigenvalues>
 #include <Eigen/Geometry>
 
+#include "cube_scan_matcher/core/deskew.h"
 #include "require_in_range.h"
 
 namespace cube_scan_matcher {
@@ -58,9 +59,11 @@ struct Row {
 /// With `near`, also collects the scan points that found a plane (the only ones the later
 /// iterations need to look at: the pose moves by millimetres); with `rows`, every
 /// correspondence's normal and weight.
+/// With `scale`, each point's Jacobian is multiplied by scale[i] (the sweep polish).
 Linearisation linearise(const PlaneMap& map, const PointArray& scan, const Eigen::Matrix3d& R,
                         const Eigen::Vector3d& t, double kernel, PointArray* near = nullptr,
-                        std::vector<Row>* rows = nullptr) {
+                        std::vector<Row>* rows = nullptr, const std::vector<float>* scale = nullptr,
+                        std::vector<std::size_t>* near_index = nullptr) {
   Linearisation L;
   const double k2 = kernel * kernel;
   const double max_r = map.voxel();
@@ -70,6 +73,7 @@ Linearisation linearise(const PlaneMap& map, const PointArray& scan, const Eigen
     const LocalPlane* plane = map.planeAt(q);
     if (!plane) continue;
     if (near) near->push_back(scan.x[i], scan.y[i], scan.z[i]);
+    if (near_index) near_index->push_back(i);
     const double r = plane->normal.dot(q - plane->mean);
     if (std::abs(r) > max_r) continue;
     const double s = k2 / (k2 + r * r);
@@ -77,6 +81,7 @@ Linearisation linearise(const PlaneMap& map, const PointArray& scan, const Eigen
     Vector6 J;
     J.head<3>() = plane->normal;
     J.tail<3>() = rp.cross(plane->normal);
+    if (scale) J *= double((*scale)[i]);
     L.H.selfadjointView<Eigen::Upper>().rankUpdate(J, w);
     if (rows) rows->push_back({plane->normal, w});
     L.g.noalias() += (w * r) * J;
@@ -240,6 +245,72 @@ PolishResult polishOnPlanes(const PlaneMap& map, const PointArray& scan, const P
     res.weak_direction << u, 0.0, 0.0, 0.0;  // the axis the scene does not fix
   }
   res.degenerate = res.weak_ratio < s.degenerate_ratio || translation_degenerate;
+  return res;
+}
+
+SweepPolishResult polishSweepOnPlanes(const PlaneMap& map, const PointArray& scan,
+                                      const std::vector<float>& tau, double interval,
+                                      const Eigen::Isometry3d& placed, const Eigen::Isometry3d& anchor,
+                                      const Pose6& pose, const PolishSettings& s, int max_iterations) {
+  SweepPolishResult res;
+  res.pose = pose;
+  if (scan.empty() || map.voxels() == 0 || !pose.allFinite() || tau.size() != scan.size() ||
+      !(interval > 0.0)) {
+    res.reason = "no points, no planes or no times";
+    return res;
+  }
+  // A step moves the pose on the left, t' = t + dt, R' = exp(dtheta) R, as the polish does; the
+  // points are re-placed with the motion it implies at every step, so the residuals are exact
+  // and only the Jacobian is approximate: a change of the pose moves a point taken at tau by
+  // about s = 1 + tau / interval of it (the sweep's points at the previous scan's time do not
+  // move, its last line moves with the pose).
+  std::vector<float> weight(tau.size());
+  for (std::size_t i = 0; i < tau.size(); ++i) weight[i] = float(std::clamp(1.0 + tau[i] / interval, 0.0, 1.0));
+  Eigen::Isometry3d T = poseToIsometry(pose);
+  const Eigen::Isometry3d T0 = T;
+  double rho = 1.0;
+  PointArray placed_now, near;
+  std::vector<std::size_t> near_index;
+  std::vector<float> near_weight, near_tau;
+  PointArray near_raw;
+  for (int it = 0; it < max_iterations; ++it) {
+    const Eigen::Isometry3d motion = anchor * T;  // T_prev_this
+    Linearisation L;
+    if (it == 0) {
+      placed_now = scan;
+      deskew(placed_now, tau, interval, placed, motion);
+      near.clear();
+      near_index.clear();
+      L = linearise(map, placed_now, T.linear(), T.translation(), s.kernel, &near, nullptr, &weight, &near_index);
+      near_weight.clear(), near_tau.clear(), near_raw.clear();
+      for (std::size_t i : near_index) {
+        near_weight.push_back(weight[i]);
+        near_tau.push_back(tau[i]);
+        near_raw.push_back(scan.x[i], scan.y[i], scan.z[i]);
+      }
+      rho = radiusOfGyration(near);
+    } else {
+      PointArray q = near_raw;
+      deskew(q, near_tau, interval, placed, motion);
+      L = linearise(map, q, T.linear(), T.translation(), s.kernel, nullptr, nullptr, &near_weight);
+    }
+    res.correspondences = L.count;
+    if (L.count < s.min_correspondences) {
+      res.reason = "too few points near a reference plane";
+      return res;
+    }
+    const Vector6 dx = step(L, spectrum(L.H, rho), s.weak_ratio);
+    if (!dx.allFinite()) break;
+    T.translation() += dx.head<3>();
+    const Eigen::Vector3d w = dx.tail<3>();
+    if (w.norm() > 0.0) T.linear() = Eigen::AngleAxisd(w.norm(), w.normalized()).toRotationMatrix() * T.linear();
+    res.iterations = it + 1;
+    if (dx.head<3>().norm() < s.tolerance_m && w.norm() < s.tolerance_rad) break;
+  }
+  res.shift_m = (T.translation() - T0.translation()).norm();
+  res.shift_rad = rotationAngle(T.linear() * T0.linear().transpose());
+  res.pose = isometryToPose(T);
+  res.applied = true;
   return res;
 }
 

@@ -177,6 +177,16 @@ void CubeRegistration::releaseScan() const {
   for (auto& w : workspaces_) w->setScan(PointArray::empty_array(), PointArray::empty_array());
 }
 
+SweepPolishResult CubeRegistration::polishSweep(const PointArray& scan, const std::vector<float>& tau,
+                                                double interval, const Eigen::Isometry3d& placed,
+                                                const Eigen::Isometry3d& anchor, const Pose6& pose,
+                                                int max_iterations) const {
+  std::lock_guard<std::mutex> lock(*mutex_);
+  if (!reference_) throw std::logic_error("CubeRegistration::polishSweep before setReference");
+  return polishSweepOnPlanes(reference_->planes, scan, tau, interval, placed, anchor, pose,
+                             settings_.polish, max_iterations);
+}
+
 int CubeRegistration::score(const PointArray& scan, const Pose6& pose) const {
   std::lock_guard<std::mutex> lock(*mutex_);
   if (!reference_) throw std::logic_error("CubeRegistration::score before setReference");

@@ -15,6 +15,44 @@ double uniform(std::mt19937_64& rng, double half) {
 
 }  // namespace
 
+Eigen::Isometry3d placeOnGround(const Scene& scene, double x, double y, double heading, double height) {
+  // Pitch and roll of a robot standing on the ground: the slope over its 1 m footprint.
+  const double h = 0.5, c = std::cos(heading), s = std::sin(heading);
+  const double z = scene.groundHeight(x, y);
+  const double front = scene.groundHeight(x + h * c, y + h * s) - scene.groundHeight(x - h * c, y - h * s);
+  const double left = scene.groundHeight(x - h * s, y + h * c) - scene.groundHeight(x + h * s, y - h * c);
+  const double pitch = -std::atan2(front, 2 * h), roll = std::atan2(left, 2 * h);
+  Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();
+  pose.linear() = rotationFromRpy(roll, pitch, heading);
+  pose.translation() = Eigen::Vector3d(x, y, z + height);
+  return pose;
+}
+
+DrivenPath::DrivenPath(const Scene& scene, const DrivenPathSettings& settings, double x0, double y0,
+                       double heading0)
+    : scene_(scene), s_(settings), x0_(x0), y0_(y0), h0_(heading0) {
+  if (!(s_.interval > 0.0)) throw std::invalid_argument("DrivenPath: interval must be > 0 s");
+}
+
+Eigen::Isometry3d DrivenPath::at(double t) const {
+  const double v = s_.speed, w = deg2rad(s_.yaw_rate_deg), dt = s_.interval;
+  double x = x0_, y = y0_, h = h0_ - 0.5 * w * dt;
+  // Closed-form arcs, one per interval of constant yaw rate (+w, -w, +w, ...).
+  for (int k = 0; t > 0.0; ++k) {
+    const double d = std::min(t, dt), rate = k % 2 == 0 ? w : -w;
+    if (std::abs(rate) < 1e-12) {
+      x += v * d * std::cos(h);
+      y += v * d * std::sin(h);
+    } else {
+      x += v / rate * (std::sin(h + rate * d) - std::sin(h));
+      y -= v / rate * (std::cos(h + rate * d) - std::cos(h));
+      h += rate * d;
+    }
+    t -= d;
+  }
+  return placeOnGround(scene_, x, y, h, s_.height);
+}
+
 Eigen::Isometry3d randomTransform(std::mt19937_64& rng, double t, double a_deg) {
   Eigen::Isometry3d e = Eigen::Isometry3d::Identity();
   e.translation() = Eigen::Vector3d(uniform(rng, t), uniform(rng, t), uniform(rng, t));

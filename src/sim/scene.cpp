@@ -31,6 +31,21 @@ std::string toString(SceneType type) {
   return "unknown";
 }
 
+std::vector<std::string> expandSceneNames(const std::vector<std::string>& names) {
+  std::vector<std::string> out;
+  const auto& types = allSceneTypes();
+  for (const std::string& n : names) {
+    if (n == "paper" || n == "robot" || n == "all") {
+      const std::size_t from = n == "robot" ? kPaperSceneTypes : 0;
+      const std::size_t to = n == "paper" ? kPaperSceneTypes : types.size();
+      for (std::size_t k = from; k < to; ++k) out.push_back(toString(types[k]));
+    } else {
+      out.push_back(toString(sceneTypeFromString(n)));
+    }
+  }
+  return out;
+}
+
 SceneType sceneTypeFromString(const std::string& name) {
   std::string known;
   for (const SceneType t : allSceneTypes()) {

@@ -4,6 +4,7 @@
 #include <cmath>
 
 #include "cube_scan_matcher/core/pose.h"
+#include "cube_scan_matcher/sim/motion.h"
 
 namespace cube_scan_matcher::sim {
 
@@ -14,16 +15,7 @@ SequenceMotion::SequenceMotion(const Scene& scene, const SequenceSettings& setti
   place();
 }
 
-void SequenceMotion::place() {
-  // Pitch and roll of a robot standing on the ground: the slope over its 1 m footprint.
-  const double h = 0.5, c = std::cos(heading_), s = std::sin(heading_);
-  const double z = scene_.groundHeight(x_, y_);
-  const double front = scene_.groundHeight(x_ + h * c, y_ + h * s) - scene_.groundHeight(x_ - h * c, y_ - h * s);
-  const double left = scene_.groundHeight(x_ - h * s, y_ + h * c) - scene_.groundHeight(x_ + h * s, y_ - h * c);
-  const double pitch = -std::atan2(front, 2 * h), roll = std::atan2(left, 2 * h);
-  pose_.linear() = rotationFromRpy(roll, pitch, heading_);
-  pose_.translation() = Eigen::Vector3d(x_, y_, z + s_.height);
-}
+void SequenceMotion::place() { pose_ = placeOnGround(scene_, x_, y_, heading_, s_.height); }
 
 void SequenceMotion::advance() {
   const double turn = deg2rad(s_.turn_step_deg);

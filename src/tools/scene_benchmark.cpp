@@ -113,22 +113,6 @@ Eigen::Isometry3d startPose(const sim::Scene& scene, const sim::Scene& scene_b,
 
 double median(const std::vector<double>& v) { return quantile(v, 0.5); }
 
-/// Scene names, with "paper", "robot" and "all" expanded; throws on an unknown name.
-std::vector<std::string> expandSceneList(const std::vector<std::string>& names) {
-  std::vector<std::string> out;
-  const auto& types = sim::allSceneTypes();
-  for (const std::string& n : names) {
-    if (n == "paper" || n == "robot" || n == "all") {
-      const std::size_t from = n == "robot" ? sim::kPaperSceneTypes : 0;
-      const std::size_t to = n == "paper" ? sim::kPaperSceneTypes : types.size();
-      for (std::size_t k = from; k < to; ++k) out.push_back(sim::toString(types[k]));
-    } else {
-      out.push_back(sim::toString(sim::sceneTypeFromString(n)));
-    }
-  }
-  return out;
-}
-
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -158,7 +142,7 @@ int main(int argc, char** argv) {
       }
       if (i + 1 >= args.size()) throw std::invalid_argument(a + ": missing value or unknown option");
       const std::string v = args[i + 1];
-      if (a == "--scenes") scenes = expandSceneList(splitList(v));
+      if (a == "--scenes") scenes = sim::expandSceneNames(splitList(v));
       else if (a == "--sweep-interval") sweep_interval = io::parseNumber(a, v);
       else if (a == "--worlds") worlds = int(io::parseNumber(a, v));
       else if (a == "--trials") trials = int(io::parseNumber(a, v));

@@ -9,6 +9,7 @@
 #include <deque>
 #include <optional>
 #include <string>
+#include <vector>
 
 #include <Eigen/Geometry>
 
@@ -29,8 +30,24 @@ struct KeyframeSettings {
   int submap_size = 3;
 };
 
+/// De-skew with the corrected motion (core/deskew.h), for scans given with per-point times.
+struct DeskewSettings {
+  /// After an accepted registration, find the pose at which every line of the sweep lies on
+  /// the reference when re-placed with the motion that pose implies (a continuous-time polish,
+  /// plane_polish.h polishSweepOnPlanes), register the sweep re-placed there again, and keep
+  /// the sweep re-placed with the final registered motion (instead of the odometry's, or none)
+  /// as the keyframe. Constant velocity since the last known scan.
+  bool enabled = false;
+  /// Rounds of polish + registration (each about one registration's time; it stops early
+  /// once a round moves the result less than 1 mm and 0.01 deg, or the gate rejects a round's
+  /// result, which is then not used). 0: only re-place the sweep with the first result's
+  /// motion. In [0, 10].
+  int iterations = 2;
+};
+
 struct OnlineMatcherSettings {
   RegistrationSettings registration;
+  DeskewSettings deskew;
   GateSettings gate;
   KeyframeSettings keyframes;
   /// Without odometry, predict a scan from the last registered motion per second (constant
@@ -59,6 +76,8 @@ struct OnlineStep {
   bool reference_updated = false;  ///< this scan is now the keyframe (the reference rebuilt).
   bool time_reset = false;         ///< time went backwards: state was reset before this scan.
   bool rejection_alarm = false;    ///< consecutive rejections >= max_consecutive_rejections.
+  bool deskewed = false;           ///< the points were re-placed with the registered motion.
+  int reregistered = 0;            ///< de-skew rounds whose registration was kept (the result is the last's).
   int consecutive_rejections = 0;
   /// The gate's max_correction bounds were multiplied by this: the time since the reference
   /// in whole scan periods (the lower quartile of the last 16 intervals), in [1, 4]; the
@@ -92,8 +111,14 @@ class OnlineMatcher {
   /// max_consecutive_rejections scans in a row were rejected (the chain then moves on from the
   /// prediction). The gate's correction bounds and the search's restart bounds grow with the
   /// time the prediction spans, in whole scan periods: see OnlineStep::gate_scale.
+  /// `times` (optional, one per point): each point's time [s] relative to `stamp` (<= 0 for a
+  /// sweep stamped at its end); the points were placed in the base frame at `stamp` with the
+  /// odometry's motion (with `odom` given) or with none. With settings().deskew.enabled an
+  /// accepted scan is re-placed with the registered motion (DeskewSettings), and the keyframe
+  /// keeps the re-placed points. Throws std::invalid_argument if times has the wrong size.
   OnlineStep process(const PointArray& points, double stamp,
-                     const std::optional<Eigen::Isometry3d>& odom);
+                     const std::optional<Eigen::Isometry3d>& odom,
+                     const std::vector<float>* times = nullptr);
 
   /// Forgets the reference, the pose chain and the rejection count.
   void reset();
@@ -123,6 +148,13 @@ class OnlineMatcher {
   /// be built, with the reason in `why`.
   bool addKeyframe(Keyframe keyframe, std::string& why);
   double gateScale(double stamp, double since) const;
+  /// De-skews an accepted scan with the registered motion over `interval` [s] since
+  /// last_known_ into `out`, and registers it once more if the settings say so (keeping the
+  /// second result only if the gate accepts it).
+  void deskewScan(OnlineStep& step, const PointArray& points, const std::vector<float>& times,
+                  double interval, const std::optional<Eigen::Isometry3d>& odom,
+                  const Keyframe& keyframe, const GateSettings& gate_settings,
+                  std::optional<PointArray>& out);
   OnlineMatcherSettings settings_;
   CubeRegistration registration_;
   std::deque<Keyframe> keyframes_;  // oldest first; back() is the reference's frame

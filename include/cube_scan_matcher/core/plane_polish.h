@@ -7,8 +7,10 @@
 #pragma once
 
 #include <string>
+#include <vector>
 
 #include <Eigen/Core>
+#include <Eigen/Geometry>
 
 #include "cube_scan_matcher/core/plane_map.h"
 #include "cube_scan_matcher/core/point_array.h"
@@ -93,5 +95,28 @@ struct PolishResult {
 /// Polishes `pose` (scan -> reference, eq. 2) on `map` with the points of `scan`.
 PolishResult polishOnPlanes(const PlaneMap& map, const PointArray& scan, const Pose6& pose,
                             const PolishSettings& settings);
+
+/// The continuous-time polish of a sweep taken while moving (issue 15).
+struct SweepPolishResult {
+  bool applied = false;
+  std::string reason;        ///< why not applied
+  Pose6 pose = Pose6::Zero();
+  int iterations = 0;
+  int correspondences = 0;
+  double shift_m = 0.0, shift_rad = 0.0;  ///< how far it moved the pose [m], [rad]
+};
+
+/// Polishes `pose` (scan -> reference, eq. 2) of a sweep whose points were placed with the
+/// motion `placed` (T_prev_this, core/deskew.h; identity for a rigid sweep) and taken at
+/// times `tau` [s] relative to the scan's stamp, `interval` [s] after the previous scan:
+/// every Gauss-Newton step re-places the points with the motion the pose implies,
+/// anchor * pose (anchor = T_prev_reference), so that the result is the pose at which every
+/// line of the sweep lies on the reference's planes, not a compromise between the lines.
+/// At most max_iterations steps; stops at the settings' tolerances.
+SweepPolishResult polishSweepOnPlanes(const PlaneMap& map, const PointArray& scan,
+                                      const std::vector<float>& tau, double interval,
+                                      const Eigen::Isometry3d& placed, const Eigen::Isometry3d& anchor,
+                                      const Pose6& pose, const PolishSettings& settings,
+                                      int max_iterations);
 
 }  // namespace cube_scan_matcher

@@ -145,6 +145,12 @@ class CubeRegistration {
   /// J of `scan` at `pose` on the coarse grid, with the same scan preparation as the result's
   /// J in align() (collapsing, all points). Needs a reference; returns 0 for an empty scan.
   int score(const PointArray& scan, const Pose6& pose) const;
+  /// polishSweepOnPlanes() on the reference's planes with the polish settings (issue 15).
+  /// Needs a reference with planes (else not applied, with the reason).
+  SweepPolishResult polishSweep(const PointArray& scan, const std::vector<float>& tau,
+                                double interval, const Eigen::Isometry3d& placed,
+                                const Eigen::Isometry3d& anchor, const Pose6& pose,
+                                int max_iterations) const;
 
   const RegistrationSettings& settings() const { return settings_; }
   /// Takes effect at the next setReference()/align(); validates. A new cube_edge, max_cubes

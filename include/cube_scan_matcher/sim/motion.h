@@ -40,6 +40,33 @@ class RobotMotion {
   Eigen::Isometry3d pose_ = Eigen::Isometry3d::Identity();
 };
 
+/// T_world_base of a robot standing on the ground at (x, y) [m] with `heading` [rad]: base
+/// `height` [m] above the ground, pitch and roll from the ground's slope over a 1 m footprint.
+Eigen::Isometry3d placeOnGround(const Scene& scene, double x, double y, double heading, double height);
+
+/// Continuous motion for sweeps taken while driving (issue 15): constant speed along the
+/// heading, and a yaw rate whose sign flips every `interval` (a zigzag about the heading
+/// `heading0` the path starts from: the heading sweeps between heading0 -+ yaw_rate *
+/// interval / 2, so the robot stays within speed / yaw_rate * (1 - cos(yaw_rate * interval
+/// / 2)) [m] of the axis). On the ground (placeOnGround).
+struct DrivenPathSettings {
+  double speed = 1.0;          ///< [m/s]
+  double yaw_rate_deg = 10.0;  ///< [deg/s]
+  double interval = 2.0;       ///< [s] between flips of the yaw rate
+  double height = 1.0;         ///< [m] base_link above the ground
+};
+class DrivenPath {
+ public:
+  DrivenPath(const Scene& scene, const DrivenPathSettings& settings, double x0, double y0, double heading0);
+  /// T_world_base at time t >= 0 [s] (t = 0: (x0, y0), heading heading0 - yaw_rate*interval/2).
+  Eigen::Isometry3d at(double t) const;
+
+ private:
+  const Scene& scene_;
+  DrivenPathSettings s_;
+  double x0_, y0_, h0_;
+};
+
 /// A transform with uniform errors within +-t [m] on x, y, z and +-a_deg [deg] on roll, pitch,
 /// yaw (eq. 2): the odometry error of one increment.
 Eigen::Isometry3d randomTransform(std::mt19937_64& rng, double t, double a_deg);

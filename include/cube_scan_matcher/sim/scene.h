@@ -40,6 +40,9 @@ constexpr std::size_t kPaperSceneTypes = 4;
 /// A type's name as above; throws std::invalid_argument for an unknown one.
 SceneType sceneTypeFromString(const std::string& name);
 std::string toString(SceneType type);
+/// Scene names, with "paper", "robot" and "all" expanded (the tools' --scenes); throws
+/// std::invalid_argument on an unknown name.
+std::vector<std::string> expandSceneNames(const std::vector<std::string>& names);
 
 /// A person (vertical cylinder, 0.25 m radius, 1.7 m tall) or a car (axis-aligned 4.5 x 1.8 x
 /// 1.5 m box) at p0 (x, y on the ground, z of the ground) at t = 0, moving at v [m/s].

@@ -6,7 +6,9 @@
 #pragma once
 
 #include <cstdint>
+#include <functional>
 #include <random>
+#include <vector>
 
 #include <Eigen/Geometry>
 
@@ -51,6 +53,20 @@ void addNoReturnPatches(Scene& scene, std::mt19937_64& rng, int count);
 /// returns the points in the sensor frame.
 PointArray scan(const Scene& scene, const ScannerModel& model, const Eigen::Isometry3d& sensor_pose,
                 std::mt19937_64& rng, const SweepOptions& options = {});
+
+/// A sweep taken while the scanner moves (issue 15): the model's 2D lines evenly spaced in time
+/// over [t_ref - duration, t_ref] (the reference time is the last line's), each cast from
+/// `sensor_pose(t)` (T_world_sensor, eq. 1's frame) at its own time; tilt_up: the first line
+/// at psi_min, else at psi_max (a tilting scanner sweeps up and down in turn). Beams within a
+/// line are simultaneous (a 2D line takes ~1/75 s). The scene is the one given at every line.
+struct TimedSweep {
+  PointArray points;        ///< each in the sensor frame at its line's time
+  std::vector<float> time;  ///< [s] line time - t_ref (in [-duration, 0]), one per point
+};
+TimedSweep scanDuringMotion(const Scene& scene, const ScannerModel& model,
+                            const std::function<Eigen::Isometry3d(double)>& sensor_pose,
+                            double t_ref, double duration, bool tilt_up, std::mt19937_64& rng,
+                            const SweepOptions& options = {});
 
 /// One sweep from a robot at `body` (T_world_base) with the sensor mounted at the base's
 /// origin (sensorToBodyRotation()), returned in the base frame (REP-103 axes).
