@@ -53,4 +53,31 @@ PointArray filterPoints(const PointArray& in, const RangeFilterSettings& setting
   return out;
 }
 
+PointArray filterPoints(const PointArray& in, const std::vector<float>& times,
+                        const RangeFilterSettings& settings, std::vector<float>& times_out,
+                        FilterStats* stats) {
+  if (times.size() != in.size()) {
+    throw std::invalid_argument("filterPoints: " + std::to_string(times.size()) + " times for " +
+                                std::to_string(in.size()) + " points");
+  }
+  PointArray out;
+  FilterStats st;
+  st.input = in.size();
+  times_out.clear();
+  for (std::size_t i = 0; i < in.size(); ++i) {
+    if (!std::isfinite(times[i])) {  // a point without a time cannot be placed
+      ++st.non_finite;
+      continue;
+    }
+    const std::size_t before = out.size();
+    const FilterStats one = appendFiltered(&in.x[i], &in.y[i], &in.z[i], 1, 1, settings, out);
+    st.non_finite += one.non_finite;
+    st.out_of_range += one.out_of_range;
+    if (out.size() > before) times_out.push_back(times[i]);
+  }
+  st.kept = out.size();
+  if (stats) *stats = st;
+  return out;
+}
+
 }  // namespace cube_scan_matcher

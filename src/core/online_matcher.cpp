@@ -106,24 +106,24 @@ double OnlineMatcher::gateScale(double stamp, double since) const {
 }
 
 void OnlineMatcher::deskewScan(OnlineStep& step, const PointArray& points,
-                               const std::vector<float>& times, double interval,
+                               const PointTimes& times, double interval,
                                const std::optional<Eigen::Isometry3d>& odom, const Keyframe& keyframe,
                                const GateSettings& gate_settings, std::optional<PointArray>& out) {
   // The motion since the last known scan: as placed (odometry at both ends, else none) and as
   // registered (anchor * increment, anchor = T_prev_keyframe); constant velocity over the
   // interval (core/deskew.h).
-  const Eigen::Isometry3d placed = odom && last_known_->odom
+  const Eigen::Isometry3d placed = times.placed_by_odometry && odom && last_known_->odom
                                        ? last_known_->odom->inverse() * *odom
                                        : Eigen::Isometry3d::Identity();
   const Eigen::Isometry3d anchor = last_known_->pose.inverse() * keyframe.pose;
   for (int round = 0; round < settings_.deskew.iterations; ++round) {
     // The pose at which every line lies on the reference (plane_polish.h), then a full
     // registration of the sweep re-placed there: the result the gate judges.
-    const SweepPolishResult sp = registration_.polishSweep(points, times, interval, placed, anchor,
+    const SweepPolishResult sp = registration_.polishSweep(points, times.tau, interval, placed, anchor,
                                                            step.result.pose, 20);
     if (!sp.applied) break;
     out = points;
-    deskew(*out, times, interval, placed, anchor * poseToIsometry(sp.pose));
+    deskew(*out, times.tau, interval, placed, anchor * poseToIsometry(sp.pose));
     RegistrationResult again = registration_.align(*out, sp.pose);
     if (!again.ok() || gate(again, step.guess, gate_settings) != GateReason::Accepted) break;
     const Eigen::Isometry3d change = step.increment.inverse() * again.transform;
@@ -135,16 +135,16 @@ void OnlineMatcher::deskewScan(OnlineStep& step, const PointArray& points,
   }
   // The keyframe's points: re-placed with the final motion (from the scan as given).
   out = points;
-  deskew(*out, times, interval, placed, anchor * step.increment);
+  deskew(*out, times.tau, interval, placed, anchor * step.increment);
   step.deskewed = true;
 }
 
 OnlineStep OnlineMatcher::process(const PointArray& scan_points, double stamp,
                                   const std::optional<Eigen::Isometry3d>& odom,
-                                  const std::vector<float>* times) {
-  if (times && times->size() != scan_points.size()) {
-    throw std::invalid_argument("process: " + std::to_string(times->size()) + " point times for " +
-                                std::to_string(scan_points.size()) + " points");
+                                  const PointTimes* times) {
+  if (times && times->tau.size() != scan_points.size()) {
+    throw std::invalid_argument("process: " + std::to_string(times->tau.size()) +
+                                " point times for " + std::to_string(scan_points.size()) + " points");
   }
   OnlineStep step;
   // The scan's points, re-placed below when de-skewed (a copy only then).
@@ -218,7 +218,10 @@ OnlineStep OnlineMatcher::process(const PointArray& scan_points, double stamp,
     if (step.result.ok()) step.correction = correctionFromGuess(step.guess, step.result.pose);
     step.accepted = step.reason == GateReason::Accepted;
     if (step.accepted) step.increment = step.result.transform;
-    if (step.accepted && times && settings_.deskew.enabled && last_known_ && stamp > last_known_->stamp) {
+    const bool spread = times && !times->tau.empty() &&
+                        *std::max_element(times->tau.begin(), times->tau.end()) -
+                                *std::min_element(times->tau.begin(), times->tau.end()) > 1e-6f;
+    if (step.accepted && spread && settings_.deskew.enabled && last_known_ && stamp > last_known_->stamp) {
       deskewScan(step, scan_points, *times, stamp - last_known_->stamp, odom, *keyframe, gate_settings, deskewed);
       points_ptr = &*deskewed;
     }
@@ -272,6 +275,7 @@ OnlineStep OnlineMatcher::process(const PointArray& scan_points, double stamp,
   std::ostringstream os;
   os << toString(step.reason);
   if (step.registered) os << " (" << step.result.message << ")";
+  if (step.deskewed) os << "; de-skewed (" << step.reregistered << " rounds)";
   if (step.gate_scale > 1.0) {
     os << "; correction bounds x" << step.gate_scale
        << (step.odometry_guess ? " (scans missed)" : " (no odometry)");

@@ -74,6 +74,36 @@ PointArray fromCloud(const sensor_msgs::PointCloud2& cloud, const Eigen::Isometr
   return out;
 }
 
+std::vector<float> readTimes(const sensor_msgs::PointCloud2& cloud, const std::string& name) {
+  const sensor_msgs::PointField* f = findField(cloud, name);
+  if (!f) return {};
+  const std::uint8_t type = f->datatype;
+  if (type != sensor_msgs::PointField::FLOAT32 && type != sensor_msgs::PointField::FLOAT64) {
+    throw CloudError("cloud field " + name + " (point times) must be FLOAT32 or FLOAT64 seconds, "
+                     "datatype " + std::to_string(type));
+  }
+  const std::size_t size = type == sensor_msgs::PointField::FLOAT32 ? 4 : 8;
+  if (f->offset + size > cloud.point_step) {
+    throw CloudError("cloud field " + name + " lies outside point_step");
+  }
+  const std::size_t width = cloud.width, height = cloud.height;
+  if (width * height == 0) return {};
+  if (std::size_t(cloud.point_step) * width > cloud.row_step ||
+      std::size_t(cloud.row_step) * height > cloud.data.size()) {
+    throw CloudError("cloud data is truncated");
+  }
+  std::vector<float> out;
+  out.reserve(width * height);
+  for (std::size_t r = 0; r < height; ++r) {
+    const std::uint8_t* row = cloud.data.data() + r * cloud.row_step;
+    for (std::size_t c = 0; c < width; ++c) {
+      const std::uint8_t* p = row + c * cloud.point_step + f->offset;
+      out.push_back(size == 4 ? readAs<float>(p) : float(readAs<double>(p)));
+    }
+  }
+  return out;
+}
+
 sensor_msgs::PointCloud2 toCloud(const PointArray& points, const Eigen::Isometry3d& transform,
                                  const std_msgs::Header& header) {
   sensor_msgs::PointCloud2 cloud;

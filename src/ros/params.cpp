@@ -62,6 +62,8 @@ void configToSettings(const ScanMatcherConfig& c, OnlineMatcherSettings& m) {
   m.keyframes.interval = c.keyframe_interval;
   m.keyframes.submap_size = c.submap_keyframes;
   m.constant_velocity = c.constant_velocity;
+  m.deskew.enabled = c.deskew;
+  m.deskew.iterations = c.deskew_iterations;
 }
 
 /// The unit in a cfg description ("Cube edge E [m] (paper ...)" -> "m"), or "".
@@ -142,6 +144,8 @@ ScanMatcherConfig toConfig(const NodeParams& p) {
   c.keyframe_interval = p.matcher.keyframes.interval;
   c.submap_keyframes = p.matcher.keyframes.submap_size;
   c.constant_velocity = p.matcher.constant_velocity;
+  c.deskew = p.matcher.deskew.enabled;
+  c.deskew_iterations = p.matcher.deskew.iterations;
   return c;
 }
 
@@ -170,6 +174,9 @@ NodeParams loadParams(const ros::NodeHandle& pnh) {
   p.filter.max_range = max_range > 0.0 ? max_range : 1e9;
   if (p.filter.max_range <= p.filter.min_range) {
     throw ParamError("parameter ~max_range must exceed ~min_range (or be 0 = no limit)");
+  }
+  if (pnh.hasParam("time_field") && !pnh.getParam("time_field", p.time_field)) {
+    throw ParamError("parameter ~time_field must be a string (empty = no point times)");
   }
   p.sigma_translation = readParam(pnh, "sigma_translation", p.sigma_translation, 1e-6, 100.0, "m");
   p.sigma_rotation = readParam(pnh, "sigma_rotation", p.sigma_rotation, 1e-6, 180.0, "deg");

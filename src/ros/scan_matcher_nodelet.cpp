@@ -318,7 +318,19 @@ bool ScanMatcherNodelet::lookupFrames(Scan& scan) {
 bool ScanMatcherNodelet::convertPoints(Scan& scan) {
   FilterStats fs;
   try {
-    scan.points = filterPoints(fromCloud(scan.msg, scan.T_base_cloud), params_.filter, &fs);
+    const PointArray all = fromCloud(scan.msg, scan.T_base_cloud);
+    const std::vector<float> tau =
+        params_.time_field.empty() ? std::vector<float>{} : readTimes(scan.msg, params_.time_field);
+    if (tau.empty()) {
+      scan.points = filterPoints(all, params_.filter, &fs);
+    } else {
+      // A sweep taken over time: a cloud in the odometry frame was placed by tf (the
+      // odometry) line by line; one in another frame is taken as rigid (core/deskew.h).
+      PointTimes times;
+      times.placed_by_odometry = scan.msg.header.frame_id == params_.odom_frame;
+      scan.points = filterPoints(all, tau, params_.filter, times.tau, &fs);
+      scan.times = std::move(times);
+    }
   } catch (const CloudError& e) {
     rejectInput(scan, e.what());
     return false;
@@ -337,7 +349,8 @@ bool ScanMatcherNodelet::convertPoints(Scan& scan) {
 OnlineStep ScanMatcherNodelet::registerScan(Scan& scan) {
   // Register, gate and chain (core).
   const OnlineStep step =
-      matcher_->process(scan.points, scan.msg.header.stamp.toSec(), scan.odom);
+      matcher_->process(scan.points, scan.msg.header.stamp.toSec(), scan.odom,
+                        scan.times ? &*scan.times : nullptr);
   ++processed_;
   const RegistrationResult& r = step.result;
   Status& status = scan.status;

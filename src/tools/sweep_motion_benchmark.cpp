@@ -147,19 +147,6 @@ Run simulate(const sim::Scene& scene, const sim::ScannerModel& model, const sim:
 
 double median(const std::vector<double>& v) { return quantile(v, 0.5); }
 
-/// filterPoints() that keeps each kept point's time beside it.
-PointArray filterTimed(const PointArray& in, const std::vector<float>& time,
-                       const RangeFilterSettings& filter, std::vector<float>& time_out) {
-  PointArray out;
-  time_out.clear();
-  for (std::size_t i = 0; i < in.size(); ++i) {
-    const std::size_t before = out.size();
-    appendFiltered(&in.x[i], &in.y[i], &in.z[i], 1, 1, filter, out);
-    if (out.size() > before) time_out.push_back(time[i]);
-  }
-  return out;
-}
-
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -279,11 +266,11 @@ int main(int argc, char** argv) {
                 std::vector<Eigen::Isometry3d> poses;
                 for (int k = 0; k < sweeps; ++k) {
                   const bool rigid_input = mode == "static" || mode == "ideal" || (from_rest && k == 0);
-                  std::vector<float> times;
+                  PointTimes times;  // placed by the odometry, as an assembler in odom gives it
                   const PointArray pts =
                       mode == "static"  ? filterPoints(run.still[k], filter)
                       : mode == "ideal" ? filterPoints(run.ideal[k], filter)
-                                        : filterTimed(run.moving[k], run.times[k], filter, times);
+                                        : filterPoints(run.moving[k], run.times[k], filter, times.tau);
                   const auto start = std::chrono::steady_clock::now();
                   const OnlineStep step =
                       matcher.process(pts, k * duration, run.odom[k], rigid_input ? nullptr : &times);

@@ -303,7 +303,8 @@ std::vector<double> movingSweepErrors(bool deskew, std::vector<double>& angle_er
       placed.push_back(float(q.x()), float(q.y()), float(q.z()));
     }
     odom = odom * odom_increment;
-    const OnlineStep step = m.process(placed, k * d, odom, &sweep.time);
+    const PointTimes times{sweep.time, true};
+    const OnlineStep step = m.process(placed, k * d, odom, &times);
     EXPECT_TRUE(step.accepted) << step.message;
     EXPECT_EQ(step.deskewed, deskew);
     const Eigen::Isometry3d estimate = pose.inverse() * step.pose;
@@ -330,10 +331,22 @@ TEST(OnlineMatcher, DeskewWithTheRegisteredMotionUnbendsSweepsTakenWhileDriving)
   }
 }
 
-TEST(OnlineMatcher, PointTimesOfTheWrongSizeAreRefused) {
+TEST(OnlineMatcher, PointTimesOfTheWrongSizeAreRefusedAndEqualTimesAreRigid) {
   OnlineMatcher m{OnlineMatcherSettings{}};
   PointArray pts;
   pts.push_back(1, 2, 3);
-  const std::vector<float> times = {0.0f, -0.1f};
+  const PointTimes times{{0.0f, -0.1f}, true};
   EXPECT_THROW(m.process(pts, 0.0, std::nullopt, &times), std::invalid_argument);
+  // A scan whose points share one time (stop and go) is registered as given: not de-skewed.
+  const sim::Scene scene = sim::Scene::generate(sim::SceneType::Urban, 2);
+  std::mt19937_64 rng(3);
+  Eigen::Isometry3d a = Eigen::Isometry3d::Identity(), b = a;
+  a.translation() = Eigen::Vector3d(20, 0, 1);
+  b.translation() = Eigen::Vector3d(21.5, 0, 1);
+  m.process(scanInBase(scene, a, rng), 1.0, a);
+  const PointArray scan = scanInBase(scene, b, rng);
+  const PointTimes same{std::vector<float>(scan.size(), 0.0f), true};
+  const OnlineStep step = m.process(scan, 2.0, b, &same);
+  EXPECT_TRUE(step.accepted) << step.message;
+  EXPECT_FALSE(step.deskewed);
 }

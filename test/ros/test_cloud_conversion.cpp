@@ -108,3 +108,36 @@ TEST(CloudConversion, MalformedCloudsGiveAClearError) {
   sensor_msgs::PointCloud2 empty = doubleCloud(0);
   EXPECT_TRUE(fromCloud(empty).empty());
 }
+
+TEST(CloudConversion, PointTimesAreReadBesideThePointsAndFilteredWithThem) {
+  sensor_msgs::PointCloud2 c;
+  sensor_msgs::PointCloud2Modifier m(c);
+  m.setPointCloud2Fields(4, "x", 1, sensor_msgs::PointField::FLOAT32, "y", 1,
+                         sensor_msgs::PointField::FLOAT32, "z", 1, sensor_msgs::PointField::FLOAT32,
+                         "time", 1, sensor_msgs::PointField::FLOAT32);
+  m.resize(4);
+  sensor_msgs::PointCloud2Iterator<float> x(c, "x"), y(c, "y"), z(c, "z"), t(c, "time");
+  const float nan = std::nanf("");
+  const float xs[4] = {1, nan, 3, 4}, ts[4] = {-0.3f, -0.2f, nan, 0.0f};
+  for (int i = 0; i < 4; ++i, ++x, ++y, ++z, ++t) *x = xs[i], *y = 0, *z = 0, *t = ts[i];
+  const std::vector<float> times = readTimes(c, "time");
+  ASSERT_EQ(times.size(), 4u);
+  EXPECT_FLOAT_EQ(times[0], -0.3f);
+  EXPECT_TRUE(readTimes(c, "t").empty());  // no such field: a rigid sweep
+  // A point without a position or without a time is dropped with its time.
+  std::vector<float> kept;
+  FilterStats st;
+  const PointArray pts = filterPoints(fromCloud(c), times, RangeFilterSettings{}, kept, &st);
+  ASSERT_EQ(pts.size(), 2u);
+  EXPECT_EQ(kept, (std::vector<float>{-0.3f, 0.0f}));
+  EXPECT_FLOAT_EQ(pts.x[1], 4.0f);
+  EXPECT_EQ(st.non_finite, 2u);
+  // A time field of another type is named.
+  c.fields[3].datatype = sensor_msgs::PointField::UINT32;
+  try {
+    readTimes(c, "time");
+    FAIL() << "no CloudError";
+  } catch (const CloudError& e) {
+    EXPECT_NE(std::string(e.what()).find("time"), std::string::npos) << e.what();
+  }
+}

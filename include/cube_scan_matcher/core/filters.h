@@ -2,6 +2,7 @@
 #pragma once
 
 #include <cstddef>
+#include <vector>
 
 #include <Eigen/Core>
 
@@ -34,6 +35,12 @@ FilterStats appendFiltered(const float* x, const float* y, const float* z, std::
 
 /// Filters a PointArray (convenience over appendFiltered).
 PointArray filterPoints(const PointArray& in, const RangeFilterSettings& settings,
+                        FilterStats* stats = nullptr);
+
+/// The same with a time per point: the kept points' times go to `times_out` (a point whose time
+/// is NaN or inf is dropped as non-finite). Throws std::invalid_argument on a size mismatch.
+PointArray filterPoints(const PointArray& in, const std::vector<float>& times,
+                        const RangeFilterSettings& settings, std::vector<float>& times_out,
                         FilterStats* stats = nullptr);
 
 }  // namespace cube_scan_matcher

@@ -36,13 +36,23 @@ struct DeskewSettings {
   /// the reference when re-placed with the motion that pose implies (a continuous-time polish,
   /// plane_polish.h polishSweepOnPlanes), register the sweep re-placed there again, and keep
   /// the sweep re-placed with the final registered motion (instead of the odometry's, or none)
-  /// as the keyframe. Constant velocity since the last known scan.
-  bool enabled = false;
+  /// as the keyframe. Constant velocity since the last known scan. Only scans given with
+  /// point times that differ (a sweep taken over time) are touched.
+  bool enabled = true;
   /// Rounds of polish + registration (each about one registration's time; it stops early
   /// once a round moves the result less than 1 mm and 0.01 deg, or the gate rejects a round's
   /// result, which is then not used). 0: only re-place the sweep with the first result's
   /// motion. In [0, 10].
   int iterations = 2;
+};
+
+/// The per-point times of a scan taken over time (a tilting scanner's sweep, a spinning
+/// LiDAR's turn), for the de-skew.
+struct PointTimes {
+  std::vector<float> tau;  ///< [s] each point's time relative to the scan's stamp
+  /// The points were placed in the base frame at the stamp with the odometry's motion (a cloud
+  /// assembled in the odometry frame through tf); false: with none (a sweep in the sensor frame).
+  bool placed_by_odometry = true;
 };
 
 struct OnlineMatcherSettings {
@@ -111,14 +121,13 @@ class OnlineMatcher {
   /// max_consecutive_rejections scans in a row were rejected (the chain then moves on from the
   /// prediction). The gate's correction bounds and the search's restart bounds grow with the
   /// time the prediction spans, in whole scan periods: see OnlineStep::gate_scale.
-  /// `times` (optional, one per point): each point's time [s] relative to `stamp` (<= 0 for a
-  /// sweep stamped at its end); the points were placed in the base frame at `stamp` with the
-  /// odometry's motion (with `odom` given) or with none. With settings().deskew.enabled an
-  /// accepted scan is re-placed with the registered motion (DeskewSettings), and the keyframe
-  /// keeps the re-placed points. Throws std::invalid_argument if times has the wrong size.
+  /// `times` (optional): each point's time relative to `stamp` and how the points were placed
+  /// (PointTimes). With settings().deskew.enabled an accepted scan is re-placed with the
+  /// registered motion (DeskewSettings), and the keyframe keeps the re-placed points. Throws
+  /// std::invalid_argument if times->tau has the wrong size.
   OnlineStep process(const PointArray& points, double stamp,
                      const std::optional<Eigen::Isometry3d>& odom,
-                     const std::vector<float>* times = nullptr);
+                     const PointTimes* times = nullptr);
 
   /// Forgets the reference, the pose chain and the rejection count.
   void reset();
@@ -151,7 +160,7 @@ class OnlineMatcher {
   /// De-skews an accepted scan with the registered motion over `interval` [s] since
   /// last_known_ into `out`, and registers it once more if the settings say so (keeping the
   /// second result only if the gate accepts it).
-  void deskewScan(OnlineStep& step, const PointArray& points, const std::vector<float>& times,
+  void deskewScan(OnlineStep& step, const PointArray& points, const PointTimes& times,
                   double interval, const std::optional<Eigen::Isometry3d>& odom,
                   const Keyframe& keyframe, const GateSettings& gate_settings,
                   std::optional<PointArray>& out);

@@ -4,6 +4,7 @@
 
 #include <stdexcept>
 #include <string>
+#include <vector>
 
 #include <Eigen/Geometry>
 #include <sensor_msgs/PointCloud2.h>
@@ -23,6 +24,11 @@ class CloudError : public std::runtime_error {
 /// frame the caller wants). Throws CloudError.
 PointArray fromCloud(const sensor_msgs::PointCloud2& cloud,
                      const Eigen::Isometry3d& transform = Eigen::Isometry3d::Identity());
+
+/// The `field` of every point as seconds (FLOAT32 or FLOAT64), width * height of them in
+/// fromCloud()'s order; empty if the cloud has no such field. Throws CloudError if the field
+/// has another type or lies outside point_step (the layout is checked as fromCloud() does).
+std::vector<float> readTimes(const sensor_msgs::PointCloud2& cloud, const std::string& field);
 
 /// A dense float32 x/y/z cloud of `points` transformed by `transform`.
 sensor_msgs::PointCloud2 toCloud(const PointArray& points, const Eigen::Isometry3d& transform,

@@ -53,6 +53,9 @@ struct NodeParams {
   int queue_size = 1;             ///< subscriber queue, in [1, 100].
   int path_max_length = 10000;    ///< poses kept in ~path, in [1, 1e6].
   RangeFilterSettings filter;     ///< min_range, max_range [m] around the base_frame origin.
+  /// Field of the per-point times [s, relative to the stamp] (the sweep assembler's "time");
+  /// empty: none read. Clouds without it are rigid sweeps.
+  std::string time_field = "time";
   // Covariance of the published pose (diagonal, standard deviations).
   double sigma_translation = 0.05;   ///< [m] of an accepted registration.
   double sigma_rotation = 0.5;       ///< [deg] of an accepted registration.

@@ -49,6 +49,7 @@ class ScanMatcherNodelet : public nodelet::Nodelet {
     Eigen::Isometry3d T_base_cloud = Eigen::Isometry3d::Identity();
     std::optional<Eigen::Isometry3d> odom;  ///< T_odom_base at the stamp, if tf had it
     PointArray points;                      ///< valid points in base_frame
+    std::optional<PointTimes> times;        ///< their times, from the cloud's time_field
   };
   void countArrival(Scan& scan);    ///< input rate and dropped scans (header.seq gaps)
   bool checkHeader(Scan& scan);     ///< a stamp and a frame
