@@ -26,6 +26,7 @@ void validate(const SweepCutterSettings& s) {
     fail("max_line_gap", s.max_line_gap, "> 0 s");
   }
   if (s.min_lines < 1) fail("min_lines", s.min_lines, ">= 1");
+  if (s.max_lines < s.min_lines) fail("max_lines", s.max_lines, ">= min_lines");
 }
 
 std::string toString(CutReason reason) {
@@ -35,6 +36,7 @@ std::string toString(CutReason reason) {
     case CutReason::Duration: return "sweep_duration elapsed";
     case CutReason::Stall: return "tilt stalled";
     case CutReason::Stalled: return "tilt still stalled";
+    case CutReason::MaxLines: return "max_lines reached";
     case CutReason::Gap: return "gap between lines";
     case CutReason::TimeBackwards: return "time went backwards";
     case CutReason::LateLine: return "late line";
@@ -167,6 +169,12 @@ CutResult SweepCutter::addLine(double time, std::optional<double> angle) {
     restartTurnDetector(direction_);
   }
   pending_.push_back({time, a});
+  if (pending_.size() >= std::size_t(s.max_lines)) {  // (a duration cut leaves one line)
+    const int direction = direction_;
+    r = close(pending_.size(), CutReason::MaxLines);
+    restartTurnDetector(direction);
+    return r;
+  }
   if (!a) return r;
 
   if (s.stall_timeout > 0.0) {

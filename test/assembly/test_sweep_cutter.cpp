@@ -264,6 +264,19 @@ TEST(SweepCutter, TimeGoingBackwardsResetsAndLateLinesAreDropped) {
   EXPECT_EQ(r.closed_lines, 1u);
 }
 
+TEST(SweepCutter, MaxLinesBoundsASweepThatNeverTurns) {
+  SweepCutterSettings s;
+  s.max_lines = 50;
+  Driver d(s);
+  // A slow, steady tilt (0.05 deg per line: never stalls within 1 s, never turns).
+  for (int k = 0; k < 120; ++k) d.add(k / 40.0, (0.05 * k) * kDeg);
+  ASSERT_EQ(d.sweeps.size(), 2u);
+  EXPECT_EQ(d.sweep_reasons[0], CutReason::MaxLines);
+  EXPECT_EQ(d.sweeps[0].size(), 50u);
+  EXPECT_EQ(d.sweeps[1].front(), 50);
+  EXPECT_EQ(d.cutter.pendingLines(), 20u);
+}
+
 TEST(SweepCutter, UnwrapsAnglesAcrossPlusMinusPi) {
   // A tilt rising through 180 deg (atan2 jumps from +pi to -pi): no turning point.
   SweepCutterSettings s;
@@ -299,6 +312,9 @@ TEST(SweepCutter, InvalidSettingsAreRefusedByName) {
   s = SweepCutterSettings{};
   s.min_lines = 0;
   EXPECT_NE(message(s).find("min_lines"), std::string::npos);
+  s = SweepCutterSettings{};
+  s.max_lines = s.min_lines - 1;
+  EXPECT_NE(message(s).find("max_lines"), std::string::npos);
   EXPECT_EQ(message(SweepCutterSettings{}), "");
   SweepCutter c;
   EXPECT_THROW(c.addLine(NAN, 0.0), std::invalid_argument);

@@ -19,6 +19,8 @@
 //    Stalled, line_kept false): a scanner that stopped tilting sweeps one plane again and again,
 //    which is no 3D sweep (its period is undefined and a single plane cannot be registered).
 //    The first line that has moved on by more than the hysteresis starts a new sweep;
+//  - when the sweep reaches max_lines lines (a bound on memory for a tilt that neither turns
+//    nor stalls, e.g. a wrong tilt_axis); the line is the sweep's last (reason MaxLines);
 //  - at a gap: a line more than max_line_gap after the previous one. The line starts the next
 //    sweep;
 //  - when time goes backwards by more than max_line_gap (a bag replayed in a loop, a clock
@@ -53,6 +55,8 @@ struct SweepCutterSettings {
   double max_line_gap = 0.5;
   /// A closed sweep with fewer lines is discarded. >= 1.
   int min_lines = 10;
+  /// A sweep is closed when it has this many lines. >= min_lines.
+  int max_lines = 10000;
 };
 
 /// Throws std::invalid_argument naming the bad setting.
@@ -72,6 +76,7 @@ enum class CutReason {
   Duration,       ///< sweep_duration elapsed since the sweep's first line.
   Stall,          ///< the tilt stopped moving for stall_timeout: the sweep is closed.
   Stalled,        ///< a line while the tilt stays stalled: the line is discarded.
+  MaxLines,       ///< the sweep reached max_lines lines.
   Gap,            ///< more than max_line_gap between two lines.
   TimeBackwards,  ///< time jumped back by more than max_line_gap: the cutter was reset.
   LateLine,       ///< the line is older than the newest line (by at most max_line_gap).
