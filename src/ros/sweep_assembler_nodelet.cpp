@@ -236,6 +236,10 @@ void SweepAssemblerNodelet::processQueue() {
         useLine(*scan);
       } catch (const tf2::TransformException& e) {
         dropWaiting(Waiting{scan, now}, e.what());
+      } catch (const std::exception& e) {
+        ++lines_bad_;
+        NODELET_ERROR_THROTTLE(5.0, "line at %.3f s not used: %s", scan->header.stamp.toSec(),
+                               e.what());
       }
       continue;
     }
