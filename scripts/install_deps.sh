@@ -9,6 +9,7 @@ PKGS=(
   build-essential cmake catkin libeigen3-dev libpcl-dev libgtest-dev catkin-lint
   libroscpp-dev libnodeletlib-dev libnodelet-dev libnodeletlib-tools pluginlib-dev
   libtf2-ros-dev libtf2-eigen-dev libtf2-geometry-msgs-dev libtf2-sensor-msgs-dev libpcl-ros-dev
+  liblaser-geometry-dev
   ros-sensor-msgs ros-geometry-msgs ros-nav-msgs ros-std-srvs ros-message-generation
   ros-message-runtime libdynamic-reconfigure-config-init-mutex-dev python3-dynamic-reconfigure
   libdiagnostic-updater-dev librostest-dev python3-rostest python3-roslaunch python3-rosmaster
