@@ -104,6 +104,13 @@ PointArray scan(const Scene& full_scene, const ScannerModel& m, const Eigen::Iso
   return out;
 }
 
+PointArray scanLine(const Scene& full_scene, const ScannerModel& m, const Eigen::Isometry3d& pose,
+                    double psi, std::mt19937_64& rng, bool keep_invalid) {
+  PointArray out;
+  castLine(cull(full_scene, pose.translation(), m.max_range + 1.0), m, pose, psi, rng, keep_invalid, out);
+  return out;
+}
+
 TimedSweep scanDuringMotion(const Scene& full_scene, const ScannerModel& m,
                             const std::function<Eigen::Isometry3d(double)>& sensor_pose,
                             double t_ref, double duration, bool tilt_up, std::mt19937_64& rng,

@@ -2,7 +2,9 @@
 // the robot motion.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
+#include <random>
 #include <string>
 
 #include "cube_scan_matcher/core/pose.h"
@@ -154,4 +156,47 @@ TEST(SimMotion, StaysInTheSceneAndMovesLikeThePapersPairs) {
     prev = robot.pose();
   }
   EXPECT_THROW(sim::odometryErrorFromString("huge"), std::invalid_argument);
+}
+
+TEST(TiltingScanner, ALineIsTheSweepsLineAndLiesInTheTiltedPlane) {
+  const sim::Scene scene = sim::Scene::generate(sim::SceneType::Urban, 3);
+  const sim::ScannerModel model;
+  Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();
+  pose.linear() = sim::sensorToBodyRotation();
+  pose.translation() = Eigen::Vector3d(20, 0, 1);
+  std::mt19937_64 a(5), b(5);
+  const PointArray sweep = sim::scan(scene, model, pose, a, sim::SweepOptions{true});
+  const double psi = deg2rad(model.psi_min_deg);
+  const PointArray line = sim::scanLine(scene, model, pose, psi, b);
+  ASSERT_EQ(line.size(), std::size_t(model.phiCount()));
+  const Eigen::Matrix3d to_laser = Eigen::AngleAxisd(-psi, Eigen::Vector3d::UnitX()).toRotationMatrix();
+  int hits = 0;
+  for (std::size_t i = 0; i < line.size(); ++i) {
+    if (std::isnan(line.x[i])) {
+      EXPECT_TRUE(std::isnan(sweep.x[i]));
+      continue;
+    }
+    ++hits;
+    EXPECT_EQ(line.point(i), sweep.point(i));  // the sweep's first line, bit for bit
+    const Eigen::Vector3d q = to_laser * line.point(i).cast<double>();  // in the laser's plane
+    EXPECT_NEAR(q.z(), 0.0, 1e-4 * q.norm());
+    EXPECT_NEAR(std::atan2(q.y(), q.x()), deg2rad(model.phi_min_deg + i * model.phi_step_deg), 1e-5);
+  }
+  EXPECT_GT(hits, 100);
+}
+
+TEST(SimMotion, DrivenPathZigzagsAboutItsAxisOnTheGround) {
+  const sim::Scene scene = sim::Scene::generate(sim::SceneType::Urban, 1);
+  const sim::DrivenPath path(scene, {1.0, 20.0, 2.0, 1.0}, 10.0, 0.0, 0.0);
+  double max_y = 0.0;
+  for (double t = 0.0; t <= 20.0; t += 0.1) {
+    const Eigen::Isometry3d p = path.at(t);
+    max_y = std::max(max_y, std::abs(p.translation().y()));
+    EXPECT_NEAR(p.translation().z(), scene.groundHeight(p.translation().x(), p.translation().y()) + 1.0, 1e-9);
+  }
+  // Speed 1 m/s, yaw rate 20 deg/s flipping every 2 s: within v/w (1 - cos(20 deg)) of the axis.
+  EXPECT_LE(max_y, 1.0 / deg2rad(20.0) * (1.0 - std::cos(deg2rad(20.0))) + 1e-9);
+  // Travel at the speed: the arc length over 2 s is 2 m, its chord a little less.
+  const double chord = (path.at(2.0).translation() - path.at(0.0).translation()).norm();
+  EXPECT_NEAR(chord, 2.0 * std::sin(deg2rad(20.0)) / deg2rad(20.0), 1e-3);
 }

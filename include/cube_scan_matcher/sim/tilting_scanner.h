@@ -54,6 +54,13 @@ void addNoReturnPatches(Scene& scene, std::mt19937_64& rng, int count);
 PointArray scan(const Scene& scene, const ScannerModel& model, const Eigen::Isometry3d& sensor_pose,
                 std::mt19937_64& rng, const SweepOptions& options = {});
 
+/// One 2D line at tilt `psi` [rad] cast from `sensor_pose` (eq. 1's frame -> world), in that
+/// frame, one point per beam (phi ascending) with NaN for no return if keep_invalid: what a
+/// driver's LaserScan holds, in eq. 1's frame turned by psi about its X axis (there the
+/// beam at phi lies at [r cos(phi), r sin(phi), 0]).
+PointArray scanLine(const Scene& scene, const ScannerModel& model, const Eigen::Isometry3d& sensor_pose,
+                    double psi, std::mt19937_64& rng, bool keep_invalid = true);
+
 /// A sweep taken while the scanner moves (issue 15): the model's 2D lines evenly spaced in time
 /// over [t_ref - duration, t_ref] (the reference time is the last line's), each cast from
 /// `sensor_pose(t)` (T_world_sensor, eq. 1's frame) at its own time; tilt_up: the first line
