@@ -45,6 +45,12 @@ void OnlineMatcher::reset() {
   start_pose_.reset();
 }
 
+std::size_t OnlineMatcher::keyframeBytes() const {
+  std::size_t bytes = 0;
+  for (const Keyframe& k : keyframes_) bytes += 3 * k.points.x.capacity() * sizeof(float);
+  return bytes;
+}
+
 void OnlineMatcher::restartAt(const Eigen::Isometry3d& pose) {
   reset();
   start_pose_ = pose;

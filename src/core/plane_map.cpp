@@ -96,4 +96,10 @@ const LocalPlane* PlaneMap::planeAt(const Eigen::Vector3d& q) const {
   return fit_[index] == Fit::Plane ? &planes_[index] : nullptr;
 }
 
+std::size_t PlaneMap::memoryBytes() const {
+  return (keys_ ? keys_->capacity() * sizeof(std::uint64_t) : 0) +
+         slot_to_index_.capacity() * sizeof(std::uint32_t) + stats_.capacity() * sizeof(Stats) +
+         fit_.capacity() * sizeof(Fit) + planes_.capacity() * sizeof(LocalPlane);
+}
+
 }  // namespace cube_scan_matcher

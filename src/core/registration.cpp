@@ -177,6 +177,18 @@ void CubeRegistration::releaseScan() const {
   for (auto& w : workspaces_) w->setScan(PointArray::empty_array(), PointArray::empty_array());
 }
 
+std::size_t CubeRegistration::referenceBytes() const {
+  std::lock_guard<std::mutex> lock(*mutex_);
+  return reference_ ? reference_->memoryBytes() : 0;
+}
+
+std::size_t CubeRegistration::workspaceBytes() const {
+  std::lock_guard<std::mutex> lock(*mutex_);
+  std::size_t bytes = 0;
+  for (const auto& w : workspaces_) bytes += w->memoryBytes();
+  return bytes;
+}
+
 SweepPolishResult CubeRegistration::polishSweep(const PointArray& scan, const std::vector<float>& tau,
                                                 double interval, const Eigen::Isometry3d& placed,
                                                 const Eigen::Isometry3d& anchor, const Pose6& pose,

@@ -355,6 +355,9 @@ OnlineStep ScanMatcherNodelet::registerScan(Scan& scan) {
   const RegistrationResult& r = step.result;
   Status& status = scan.status;
   status.J = r.J;
+  status.reference_bytes = matcher_->referenceBytes();
+  status.workspace_bytes = matcher_->workspaceBytes();
+  status.keyframe_bytes = matcher_->keyframeBytes();
   status.J_guess = r.J_guess;
   status.reference_cubes = std::int32_t(r.reference_cubes);
   status.overlap = r.overlap();

@@ -36,6 +36,11 @@ class CoincidenceObjective {
   bool workingCopyRestored() const;
   /// The working copy holds a byte per cube (else a bit per cube, as V).
   bool bytePerCube() const { return !bytes_.empty(); }
+  /// Heap bytes of the working copy of V and the index buffers.
+  std::size_t memoryBytes() const {
+    return bytes_.capacity() + bits_.capacity() * sizeof(std::uint64_t) +
+           (hits_.capacity() + idx_.capacity()) * sizeof(std::int32_t);
+  }
 
  private:
   static constexpr std::size_t kBlock = 1024;  // points per index block (stays in L1)

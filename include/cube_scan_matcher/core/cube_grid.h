@@ -82,6 +82,10 @@ class CubeGrid {
   }
   const std::vector<std::uint64_t>& bits() const { return bits_; }
   const std::vector<std::int32_t>& list() const { return list_; }
+  /// Heap bytes of V and L.
+  std::size_t memoryBytes() const {
+    return bits_.capacity() * sizeof(std::uint64_t) + list_.capacity() * sizeof(std::int32_t);
+  }
 
   /// The map used by the objective for a candidate rotation R and translation t (float).
   GridAffine affine(const Eigen::Matrix3f& rotation, const Eigen::Vector3f& translation) const;

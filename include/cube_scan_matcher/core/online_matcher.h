@@ -140,6 +140,11 @@ class OnlineMatcher {
   void setSettings(const OnlineMatcherSettings& settings);
   const OnlineMatcherSettings& settings() const { return settings_; }
   bool hasReference() const { return registration_.hasReference(); }
+  /// Heap bytes of the reference (the submap's grids and planes) and of the working copies
+  /// (CubeRegistration), and of the keyframes' points kept for the submap.
+  std::size_t referenceBytes() const { return registration_.referenceBytes(); }
+  std::size_t workspaceBytes() const { return registration_.workspaceBytes(); }
+  std::size_t keyframeBytes() const;
   /// Stamp of the last processed scan [s]; nullopt after reset.
   std::optional<double> lastStamp() const { return last_stamp_; }
   /// Pose of the last processed scan in the map frame.

@@ -52,6 +52,8 @@ class PlaneMap {
   double voxel() const { return voxel_; }
   /// Occupied voxels (0 for an empty map).
   std::size_t voxels() const { return stats_.size(); }
+  /// Heap bytes of the map (hash table, voxel statistics, fitted planes).
+  std::size_t memoryBytes() const;
 
  private:
   struct Stats {

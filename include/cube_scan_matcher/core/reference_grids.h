@@ -15,6 +15,12 @@ struct ReferenceGrids {
   CubeGrid coarse;             ///< edge E: the coarse stage (and the refine's coarse term).
   std::vector<CubeGrid> fine;  ///< edge edge_fraction * E, origins shifted by k/grids.
   PlaneMap planes;             ///< the polish's local planes (empty when the polish is off).
+  /// Heap bytes of all grids and the plane map.
+  std::size_t memoryBytes() const {
+    std::size_t bytes = coarse.memoryBytes() + planes.memoryBytes();
+    for (const CubeGrid& g : fine) bytes += g.memoryBytes();
+    return bytes;
+  }
 };
 
 /// The plane map of a ReferenceGrids (see PlaneMap's constructor); none when not enabled.
@@ -46,6 +52,12 @@ class GridWorkspace {
 
   CoincidenceObjective coarse;
   std::vector<CoincidenceObjective> fine;
+  /// Heap bytes of the working copies.
+  std::size_t memoryBytes() const {
+    std::size_t bytes = coarse.memoryBytes();
+    for (const CoincidenceObjective& o : fine) bytes += o.memoryBytes();
+    return bytes;
+  }
 
  private:
   void retargetFine(const ReferenceGrids& grids);

@@ -145,6 +145,10 @@ class CubeRegistration {
   /// J of `scan` at `pose` on the coarse grid, with the same scan preparation as the result's
   /// J in align() (collapsing, all points). Needs a reference; returns 0 for an empty scan.
   int score(const PointArray& scan, const Pose6& pose) const;
+  /// Heap bytes of the reference's grids and plane map (0 without a reference), and of the
+  /// threads' working copies of them.
+  std::size_t referenceBytes() const;
+  std::size_t workspaceBytes() const;
   /// polishSweepOnPlanes() on the reference's planes with the polish settings (issue 15).
   /// Needs a reference with planes (else not applied, with the reason).
   SweepPolishResult polishSweep(const PointArray& scan, const std::vector<float>& tau,
