@@ -1,4 +1,4 @@
-// libFuzzer harness: PointCloud2 -> points on arbitrary messages (fields, offsets, types,
+// libFuzzer harness: PointCloud2 -> points and point times on arbitrary messages (fields, offsets, types,
 // counts, steps, sizes, endianness and data all from the input). CloudError is the documented
 // answer to a malformed message.
 #include <fuzzer/FuzzedDataProvider.h>
@@ -22,11 +22,11 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   msg.is_dense = in.ConsumeBool();
   msg.point_step = in.ConsumeIntegral<std::uint32_t>() % 128;
   msg.row_step = in.ConsumeBool() ? msg.point_step * msg.width : in.ConsumeIntegral<std::uint32_t>();
-  static const char* kNames[] = {"x", "y", "z", "intensity", "ring", "X", ""};
+  static const char* kNames[] = {"x", "y", "z", "intensity", "ring", "X", "time", ""};
   const int fields = in.ConsumeIntegralInRange<int>(0, 8);
   for (int k = 0; k < fields; ++k) {
     sensor_msgs::PointField f;
-    f.name = kNames[in.ConsumeIntegralInRange<int>(0, 6)];
+    f.name = kNames[in.ConsumeIntegralInRange<int>(0, 7)];
     f.offset = in.ConsumeBool() ? in.ConsumeIntegral<std::uint32_t>()
                                 : in.ConsumeIntegralInRange<std::uint32_t>(0, 64);
     f.datatype = in.ConsumeIntegralInRange<std::uint8_t>(0, 9);
@@ -38,6 +38,10 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
   try {
     cube_scan_matcher::fromCloud(msg, T);
+  } catch (const cube_scan_matcher::CloudError&) {
+  }
+  try {
+    cube_scan_matcher::readTimes(msg, "time");  // the de-skew's per-point times
   } catch (const cube_scan_matcher::CloudError&) {
   }
   return 0;
