@@ -48,22 +48,23 @@ Eigen::Isometry3d motionAt(const Twist& xi, double tau, double interval) {
   return expMotion(xi * (tau / interval));
 }
 
-void deskew(PointArray& points, const std::vector<float>& tau, double interval,
-            const Eigen::Isometry3d& placed, const Eigen::Isometry3d& truth) {
+Twist velocityOf(const Eigen::Isometry3d& motion, double interval) {
+  return interval > 0.0 ? Twist(logMotion(motion) / interval) : Twist(Twist::Zero());
+}
+
+void deskew(PointArray& points, const std::vector<float>& tau, const Twist& placed,
+            const Twist& truth) {
   if (tau.size() != points.size()) {
     throw std::invalid_argument("deskew: " + std::to_string(tau.size()) + " time offsets for " +
                                 std::to_string(points.size()) + " points");
   }
-  if (!(interval > 0.0)) throw std::invalid_argument("deskew: the interval must be > 0 s");
-  const Twist xi_placed = logMotion(placed), xi_truth = logMotion(truth);
   float last_tau = 0.0f;
   Eigen::Matrix3f R = Eigen::Matrix3f::Identity();
   Eigen::Vector3f t = Eigen::Vector3f::Zero();
   for (std::size_t i = 0; i < points.size(); ++i) {
     if (i == 0 || tau[i] != last_tau) {
       last_tau = tau[i];
-      const Eigen::Isometry3d c =
-          motionAt(xi_truth, tau[i], interval) * motionAt(xi_placed, tau[i], interval).inverse();
+      const Eigen::Isometry3d c = expMotion(truth * tau[i]) * expMotion(placed * tau[i]).inverse();
       R = c.linear().cast<float>();
       t = c.translation().cast<float>();
     }

@@ -37,6 +37,7 @@ void OnlineMatcher::reset() {
   keyframes_.clear();
   last_pose_ = Eigen::Isometry3d::Identity();
   last_known_.reset();
+  previous_odom_.reset();
   velocity_ = Pose6::Zero();
   anchor_.reset();
   last_stamp_.reset();
@@ -112,16 +113,16 @@ double OnlineMatcher::gateScale(double stamp, double since) const {
 }
 
 void OnlineMatcher::deskewScan(OnlineStep& step, const PointArray& points,
-                               const PointTimes& times, double interval,
-                               const std::optional<Eigen::Isometry3d>& odom, const Keyframe& keyframe,
-                               const GateSettings& gate_settings, std::optional<PointArray>& out) {
-  // The motion since the last known scan: as placed (odometry at both ends, else none) and as
-  // registered (anchor * increment, anchor = T_prev_keyframe); constant velocity over the
-  // interval (core/deskew.h).
-  const Eigen::Isometry3d placed = times.placed_by_odometry && odom && last_known_->odom
-                                       ? last_known_->odom->inverse() * *odom
-                                       : Eigen::Isometry3d::Identity();
+                               const PointTimes& times, double interval, const Twist& placed,
+                               const Keyframe& keyframe, const GateSettings& gate_settings,
+                               std::optional<PointArray>& out) {
+  // The velocity the points were placed with (`placed`), and the registered one: the motion
+  // since the last known scan, anchor * increment (anchor = T_known_keyframe), over `interval`
+  // (core/deskew.h).
   const Eigen::Isometry3d anchor = last_known_->pose.inverse() * keyframe.pose;
+  const auto registered = [&](const Eigen::Isometry3d& increment) {
+    return velocityOf(anchor * increment, interval);
+  };
   for (int round = 0; round < settings_.deskew.iterations; ++round) {
     // The pose at which every line lies on the reference (plane_polish.h), then a full
     // registration of the sweep re-placed there: the result the gate judges.
@@ -129,7 +130,7 @@ void OnlineMatcher::deskewScan(OnlineStep& step, const PointArray& points,
                                                            step.result.pose, 20);
     if (!sp.applied) break;
     out = points;
-    deskew(*out, times.tau, interval, placed, anchor * poseToIsometry(sp.pose));
+    deskew(*out, times.tau, placed, registered(poseToIsometry(sp.pose)));
     RegistrationResult again = registration_.align(*out, sp.pose);
     if (!again.ok() || gate(again, step.guess, gate_settings) != GateReason::Accepted) break;
     const Eigen::Isometry3d change = step.increment.inverse() * again.transform;
@@ -141,7 +142,7 @@ void OnlineMatcher::deskewScan(OnlineStep& step, const PointArray& points,
   }
   // The keyframe's points: re-placed with the final motion (from the scan as given).
   out = points;
-  deskew(*out, times.tau, interval, placed, anchor * step.increment);
+  deskew(*out, times.tau, placed, registered(step.increment));
   step.deskewed = true;
 }
 
@@ -168,6 +169,13 @@ OnlineStep OnlineMatcher::process(const PointArray& scan_points, double stamp,
     if (intervals_.size() > kIntervals) intervals_.pop_front();
   }
   last_stamp_ = stamp;
+  // The velocity the odometry placed this scan's points with: its motion since the previous
+  // scan (whatever became of that one), at constant velocity (core/deskew.h).
+  Twist placed_velocity = Twist::Zero();
+  if (times && times->placed_by_odometry && odom && previous_odom_ && stamp > previous_odom_->stamp) {
+    placed_velocity = velocityOf(previous_odom_->odom->inverse() * *odom, stamp - previous_odom_->stamp);
+  }
+  if (odom) previous_odom_ = Known{Eigen::Isometry3d::Identity(), odom, stamp};
   const bool first = keyframes_.empty();
   // The predicted pose T_map_base: odometry from the anchor, else no motion since the last
   // known pose.
@@ -228,7 +236,7 @@ OnlineStep OnlineMatcher::process(const PointArray& scan_points, double stamp,
                         *std::max_element(times->tau.begin(), times->tau.end()) -
                                 *std::min_element(times->tau.begin(), times->tau.end()) > 1e-6f;
     if (step.accepted && spread && settings_.deskew.enabled && last_known_ && stamp > last_known_->stamp) {
-      deskewScan(step, scan_points, *times, stamp - last_known_->stamp, odom, *keyframe, gate_settings, deskewed);
+      deskewScan(step, scan_points, *times, stamp - last_known_->stamp, placed_velocity, *keyframe, gate_settings, deskewed);
       points_ptr = &*deskewed;
     }
   }

@@ -250,7 +250,7 @@ PolishResult polishOnPlanes(const PlaneMap& map, const PointArray& scan, const P
 
 SweepPolishResult polishSweepOnPlanes(const PlaneMap& map, const PointArray& scan,
                                       const std::vector<float>& tau, double interval,
-                                      const Eigen::Isometry3d& placed, const Eigen::Isometry3d& anchor,
+                                      const Twist& placed, const Eigen::Isometry3d& anchor,
                                       const Pose6& pose, const PolishSettings& s, int max_iterations) {
   SweepPolishResult res;
   res.pose = pose;
@@ -274,11 +274,11 @@ SweepPolishResult polishSweepOnPlanes(const PlaneMap& map, const PointArray& sca
   std::vector<float> near_weight, near_tau;
   PointArray near_raw;
   for (int it = 0; it < max_iterations; ++it) {
-    const Eigen::Isometry3d motion = anchor * T;  // T_prev_this
+    const Twist velocity = velocityOf(anchor * T, interval);  // of T_known_this
     Linearisation L;
     if (it == 0) {
       placed_now = scan;
-      deskew(placed_now, tau, interval, placed, motion);
+      deskew(placed_now, tau, placed, velocity);
       near.clear();
       near_index.clear();
       L = linearise(map, placed_now, T.linear(), T.translation(), s.kernel, &near, nullptr, &weight, &near_index);
@@ -291,7 +291,7 @@ SweepPolishResult polishSweepOnPlanes(const PlaneMap& map, const PointArray& sca
       rho = radiusOfGyration(near);
     } else {
       PointArray q = near_raw;
-      deskew(q, near_tau, interval, placed, motion);
+      deskew(q, near_tau, placed, velocity);
       L = linearise(map, q, T.linear(), T.translation(), s.kernel, nullptr, nullptr, &near_weight);
     }
     res.correspondences = L.count;

@@ -190,7 +190,7 @@ std::size_t CubeRegistration::workspaceBytes() const {
 }
 
 SweepPolishResult CubeRegistration::polishSweep(const PointArray& scan, const std::vector<float>& tau,
-                                                double interval, const Eigen::Isometry3d& placed,
+                                                double interval, const Twist& placed,
                                                 const Eigen::Isometry3d& anchor, const Pose6& pose,
                                                 int max_iterations) const {
   std::lock_guard<std::mutex> lock(*mutex_);

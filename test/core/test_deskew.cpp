@@ -65,7 +65,7 @@ TEST(Deskew, ReplacesPointsPlacedWithAWrongMotionByTheTrueOne) {
     exact.push_back(float(t.x()), float(t.y()), float(t.z()));
   }
   PointArray fixed = as_placed;
-  deskew(fixed, tau, interval, placed, truth);
+  deskew(fixed, tau, velocityOf(placed, interval), velocityOf(truth, interval));
   double worst = 0.0, before = 0.0;
   for (std::size_t i = 0; i < fixed.size(); ++i) {
     worst = std::max(worst, double((fixed.point(i) - exact.point(i)).norm()));
@@ -75,15 +75,13 @@ TEST(Deskew, ReplacesPointsPlacedWithAWrongMotionByTheTrueOne) {
   EXPECT_LT(worst, 1e-4);   // float rounding only
   // A rigid sweep (placed = identity) de-skewed with the truth is the exact one too.
   PointArray rigid = raw;
-  deskew(rigid, tau, interval, Eigen::Isometry3d::Identity(), truth);
+  deskew(rigid, tau, Twist::Zero(), velocityOf(truth, interval));
   for (std::size_t i = 0; i < rigid.size(); ++i) EXPECT_LT((rigid.point(i) - exact.point(i)).norm(), 1e-4);
 }
 
 TEST(Deskew, BadInputIsRefused) {
   PointArray pts;
   pts.push_back(1, 2, 3);
-  EXPECT_THROW(deskew(pts, {}, 1.0, Eigen::Isometry3d::Identity(), Eigen::Isometry3d::Identity()),
-               std::invalid_argument);
-  EXPECT_THROW(deskew(pts, {0.0f}, 0.0, Eigen::Isometry3d::Identity(), Eigen::Isometry3d::Identity()),
-               std::invalid_argument);
+  EXPECT_THROW(deskew(pts, {}, Twist::Zero(), Twist::Zero()), std::invalid_argument);
+  EXPECT_EQ(velocityOf(motion(1, 0, 0, 0, 0, 0), 0.0), Twist::Zero());  // no interval: no velocity
 }

@@ -3,12 +3,11 @@
 // A tilting 2D scanner takes a sweep line by line over one to several seconds. Each point is
 // placed in the base frame at the sweep's reference time `stamp` with the motion the caller
 // believed (the odometry's, through tf) from its own time stamp + tau (tau <= 0 for a sweep
-// stamped at its last line). With both that motion and the true one at constant velocity over
-// the interval dt between the previous scan and this one (screw motions T = exp(tau / dt *
-// xi), xi = log of the increment), the truth of a point p placed with `placed` is
-//   p* = exp(tau/dt log(true)) exp(tau/dt log(placed))^-1 p,
-// where `placed` and `true` are the scan's pose seen from the previous scan's (T_prev_this).
-// A rigid sweep (no motion used to place it) has placed = identity.
+// stamped at its last line). With that motion and the true one both at constant velocity
+// (screw motions T(tau) = exp(tau v), v a twist per second: v = log(increment) / interval),
+// the truth of a point p placed with velocity v_placed is
+//   p* = exp(tau v_true) exp(tau v_placed)^-1 p.
+// A rigid sweep (no motion used to place it) has v_placed = 0.
 #pragma once
 
 #include <vector>
@@ -31,12 +30,15 @@ Eigen::Isometry3d expMotion(const Twist& xi);
 /// increment `motion` (T_prev_this) over `interval` [s]: exp(tau / interval * log(motion)).
 Eigen::Isometry3d motionAt(const Twist& xi, double tau, double interval);
 
-/// Re-places `points` (base frame at the reference time) whose time offsets `tau` [s] (same
-/// size, relative to the reference time) were placed with the increment `placed` over
-/// `interval` [s], with the increment `truth` instead (equation above). Points with equal tau
-/// share one transform (a 2D line's). Throws std::invalid_argument on a size mismatch or
-/// interval <= 0.
-void deskew(PointArray& points, const std::vector<float>& tau, double interval,
-            const Eigen::Isometry3d& placed, const Eigen::Isometry3d& truth);
+/// The constant velocity [twist per second] of the increment `motion` over `interval` [s]
+/// (zero for interval <= 0).
+Twist velocityOf(const Eigen::Isometry3d& motion, double interval);
+
+/// Re-places `points` (base frame at the reference time) with time offsets `tau` [s] (same
+/// size, relative to the reference time), placed with velocity `placed`, with velocity `truth`
+/// instead (equation above). Points with equal tau share one transform (a 2D line's). Throws
+/// std::invalid_argument on a size mismatch.
+void deskew(PointArray& points, const std::vector<float>& tau, const Twist& placed,
+            const Twist& truth);
 
 }  // namespace cube_scan_matcher

@@ -14,6 +14,7 @@
 #include <Eigen/Geometry>
 
 #include "cube_scan_matcher/core/acceptance_gate.h"
+#include "cube_scan_matcher/core/deskew.h"
 #include "cube_scan_matcher/core/registration.h"
 
 namespace cube_scan_matcher {
@@ -166,9 +167,8 @@ class OnlineMatcher {
   /// last_known_ into `out`, and registers it once more if the settings say so (keeping the
   /// second result only if the gate accepts it).
   void deskewScan(OnlineStep& step, const PointArray& points, const PointTimes& times,
-                  double interval, const std::optional<Eigen::Isometry3d>& odom,
-                  const Keyframe& keyframe, const GateSettings& gate_settings,
-                  std::optional<PointArray>& out);
+                  double interval, const Twist& placed, const Keyframe& keyframe,
+                  const GateSettings& gate_settings, std::optional<PointArray>& out);
   OnlineMatcherSettings settings_;
   CubeRegistration registration_;
   std::deque<Keyframe> keyframes_;  // oldest first; back() is the reference's frame
@@ -180,6 +180,7 @@ class OnlineMatcher {
     double stamp;
   };
   std::optional<Known> last_known_;  // the prediction without odometry starts here
+  std::optional<Known> previous_odom_;  // the last scan with odometry (pose unused): the de-skew
   Pose6 velocity_ = Pose6::Zero();   // [m/s, rad/s] the last registered motion per second
   /// The last known scan that had odometry: a scan with odometry is predicted from it, also
   /// when the scans since then had none (a tf gap).

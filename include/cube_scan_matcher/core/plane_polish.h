@@ -12,6 +12,7 @@
 #include <Eigen/Core>
 #include <Eigen/Geometry>
 
+#include "cube_scan_matcher/core/deskew.h"
 #include "cube_scan_matcher/core/plane_map.h"
 #include "cube_scan_matcher/core/point_array.h"
 #include "cube_scan_matcher/core/pose.h"
@@ -107,15 +108,15 @@ struct SweepPolishResult {
 };
 
 /// Polishes `pose` (scan -> reference, eq. 2) of a sweep whose points were placed with the
-/// motion `placed` (T_prev_this, core/deskew.h; identity for a rigid sweep) and taken at
-/// times `tau` [s] relative to the scan's stamp, `interval` [s] after the previous scan:
-/// every Gauss-Newton step re-places the points with the motion the pose implies,
-/// anchor * pose (anchor = T_prev_reference), so that the result is the pose at which every
-/// line of the sweep lies on the reference's planes, not a compromise between the lines.
-/// At most max_iterations steps; stops at the settings' tolerances.
+/// velocity `placed` (core/deskew.h; zero for a rigid sweep) and taken at times `tau` [s]
+/// relative to the scan's stamp, `interval` [s] after the last scan whose pose is known: every
+/// Gauss-Newton step re-places the points with the velocity the pose implies,
+/// log(anchor * pose) / interval (anchor = T_known_reference), so that the result is the pose
+/// at which every line of the sweep lies on the reference's planes, not a compromise between
+/// the lines. At most max_iterations steps; stops at the settings' tolerances.
 SweepPolishResult polishSweepOnPlanes(const PlaneMap& map, const PointArray& scan,
                                       const std::vector<float>& tau, double interval,
-                                      const Eigen::Isometry3d& placed, const Eigen::Isometry3d& anchor,
+                                      const Twist& placed, const Eigen::Isometry3d& anchor,
                                       const Pose6& pose, const PolishSettings& settings,
                                       int max_iterations);
 

@@ -152,7 +152,7 @@ class CubeRegistration {
   /// polishSweepOnPlanes() on the reference's planes with the polish settings (issue 15).
   /// Needs a reference with planes (else not applied, with the reason).
   SweepPolishResult polishSweep(const PointArray& scan, const std::vector<float>& tau,
-                                double interval, const Eigen::Isometry3d& placed,
+                                double interval, const Twist& placed,
                                 const Eigen::Isometry3d& anchor, const Pose6& pose,
                                 int max_iterations) const;
 
