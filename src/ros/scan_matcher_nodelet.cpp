@@ -72,8 +72,10 @@ void ScanMatcherNodelet::onInit() {
   tf_listener_ = std::make_unique<tf2_ros::TransformListener>(*tf_buffer_, nh);
   if (params_.publish_tf) {
     tf_broadcaster_ = std::make_unique<tf2_ros::TransformBroadcaster>();
-    tf_timer_ = nh.createTimer(ros::Duration(1.0 / params_.tf_rate),
-                               [this](const ros::TimerEvent&) { sendMapOdom(); });
+    // On the manager's multi-threaded queue: a registration (seconds for a de-skewed sweep)
+    // must not hold map -> odom back (sendMapOdom takes tf_mutex_ only).
+    tf_timer_ = getMTNodeHandle().createTimer(ros::Duration(1.0 / params_.tf_rate),
+                                              [this](const ros::TimerEvent&) { sendMapOdom(); });
   }
 
   pose_pub_ = pnh.advertise<geometry_msgs::PoseWithCovarianceStamped>("pose", 10);
@@ -470,14 +472,15 @@ void ScanMatcherNodelet::publishPose(const Scan& scan, const OnlineStep& step) {
   if (tf_broadcaster_ && scan.odom) {
     // REP-105: map -> odom such that map -> odom -> base_link equals the registered pose.
     bool first;
+    const Eigen::Isometry3d map_odom = step.pose * scan.odom->inverse();
     {
       std::lock_guard<std::mutex> lock(tf_mutex_);
       first = !map_odom_;
-      map_odom_ = step.pose * scan.odom->inverse();
+      map_odom_ = map_odom;
     }
     // The first one also at the scan's stamp: valid from there, not only from now + tolerance.
     if (first) {
-      tf_broadcaster_->sendTransform(stampedTransform(*map_odom_, params_.map_frame,
+      tf_broadcaster_->sendTransform(stampedTransform(map_odom, params_.map_frame,
                                                       params_.odom_frame, header.stamp));
     }
     sendMapOdom();
