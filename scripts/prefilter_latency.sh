@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
-# The demo with and without the pcl_ros prefilter (CropBox + VoxelGrid in the matcher's
-# manager): median latency (arrival to publish), data age (stamp to publish), registration
-# time and points per sweep from ~status. Needs a built package.
+# The demo (input:=sweeps: the prefilter takes no sweep assembled in odom) with and without the
+# pcl_ros prefilter (CropBox + VoxelGrid in the matcher's manager): median latency (arrival to
+# publish), data age (stamp to publish), registration time and points per sweep from ~status.
+# Needs a built package.
 #   bash scripts/prefilter_latency.sh [SWEEPS] [SCENE]
 set -eo pipefail
 SWEEPS="${1:-15}"; SCENE="${2:-urban}"
@@ -11,7 +12,7 @@ source "${CSM_SETUP:-$ROOT/build/devel/setup.bash}"
 WORK="$(mktemp -d)"
 for prefilter in false true; do
   export ROS_MASTER_URI=http://localhost:$((12400 + RANDOM % 500))
-  roslaunch -p "${ROS_MASTER_URI##*:}" cube_scan_matcher demo.launch scene:="$SCENE" \
+  roslaunch -p "${ROS_MASTER_URI##*:}" cube_scan_matcher demo.launch input:=sweeps scene:="$SCENE" \
     sweeps:="$SWEEPS" prefilter:="$prefilter" > "$WORK/launch_$prefilter.log" 2>&1 &
   PID=$!
   for _ in $(seq 60); do rostopic list > /dev/null 2>&1 && break; sleep 0.5; done

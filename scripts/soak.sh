@@ -1,9 +1,10 @@
 #!/usr/bin/env bash
-# Soak (RELIABILITY.md): records a demo bag (simulated tilting scanner, ground truth, tf), then
-# replays it in a loop at RATE x through launch/bag_replay.launch into the nodelet for MINUTES,
-# while soak_monitor tracks the manager's resident memory, latency, drops and every
-# registration against the truth. Fails if the manager dies, memory grows (second half's
-# maximum beyond 110 % of the first half's) or nothing is processed. Needs a built package.
+# Soak (RELIABILITY.md): records a demo bag (the simulated tilting scanner's stop-and-go sweeps,
+# input:=sweeps, ground truth, tf), then replays it in a loop at RATE x through
+# launch/bag_replay.launch into the nodelet for MINUTES, while soak_monitor tracks the manager's
+# resident memory, latency, drops and every registration against the truth. Fails if the
+# manager dies, memory grows (second half's maximum beyond 110 % of the first half's) or
+# nothing is processed. Needs a built package.
 #   bash scripts/soak.sh [MINUTES] [RATE] [SWEEPS]     (defaults 10, 5, 30)
 set -eo pipefail
 MINUTES="${1:-10}"; RATE="${2:-5}"; SWEEPS="${3:-30}"
@@ -22,7 +23,7 @@ cleanup() {
 trap cleanup EXIT
 
 echo "soak: recording $SWEEPS demo sweeps (urban, big odometry errors) into a bag"
-roslaunch -p "$PORT" cube_scan_matcher demo.launch sweeps:="$SWEEPS" record:="$WORK/demo.bag" \
+roslaunch -p "$PORT" cube_scan_matcher demo.launch input:=sweeps sweeps:="$SWEEPS" record:="$WORK/demo.bag" \
   > "$WORK/record.log" 2>&1 || true
 for _ in $(seq 20); do [ -f "$WORK/demo.bag" ] && break; sleep 0.5; done
 [ -f "$WORK/demo.bag" ] || { echo "soak: no bag recorded"; tail -20 "$WORK/record.log"; exit 1; }
