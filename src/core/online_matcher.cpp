@@ -232,9 +232,10 @@ OnlineStep OnlineMatcher::process(const PointArray& scan_points, double stamp,
     if (step.result.ok()) step.correction = correctionFromGuess(step.guess, step.result.pose);
     step.accepted = step.reason == GateReason::Accepted;
     if (step.accepted) step.increment = step.result.transform;
-    const bool spread = times && !times->tau.empty() &&
-                        *std::max_element(times->tau.begin(), times->tau.end()) -
-                                *std::min_element(times->tau.begin(), times->tau.end()) > 1e-6f;
+    const bool spread = times && !times->tau.empty() && [&] {
+      const auto [lo, hi] = std::minmax_element(times->tau.begin(), times->tau.end());
+      return *hi - *lo > 1e-6f;
+    }();
     if (step.accepted && spread && settings_.deskew.enabled && last_known_ && stamp > last_known_->stamp) {
       deskewScan(step, scan_points, *times, stamp - last_known_->stamp, placed_velocity, *keyframe, gate_settings, deskewed);
       points_ptr = &*deskewed;

@@ -5,6 +5,7 @@
 #include <limits>
 #include <vector>
 
+#include "cube_scan_matcher/core/deskew.h"
 #include "cube_scan_matcher/core/pose.h"
 
 namespace cube_scan_matcher::sim {
@@ -133,6 +134,26 @@ TimedSweep scanDuringMotion(const Scene& full_scene, const ScannerModel& m,
     out.time.insert(out.time.end(), n, float(k * dt - duration));
   }
   return out;
+}
+
+PointArray placeSweep(const TimedSweep& sweep, const Eigen::Isometry3d& mount,
+                      const Eigen::Isometry3d& increment, double interval) {
+  const Twist xi = logMotion(increment);
+  PointArray placed;
+  placed.reserve(sweep.points.size());
+  // One transform per line (points of a line share their time).
+  std::size_t i = 0;
+  while (i < sweep.points.size()) {
+    std::size_t j = i;
+    while (j < sweep.points.size() && sweep.time[j] == sweep.time[i]) ++j;
+    const Eigen::Isometry3d to_ref = motionAt(xi, sweep.time[i], interval) * mount;
+    for (std::size_t n = i; n < j; ++n) {
+      const Eigen::Vector3d q = to_ref * sweep.points.point(n).cast<double>();
+      placed.push_back(float(q.x()), float(q.y()), float(q.z()));
+    }
+    i = j;
+  }
+  return placed;
 }
 
 ScannerModel scannerWithArtefacts() {

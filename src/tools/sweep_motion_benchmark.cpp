@@ -31,7 +31,6 @@
 #include <tuple>
 #include <vector>
 
-#include "cube_scan_matcher/core/deskew.h"
 #include "cube_scan_matcher/core/metrics.h"
 #include "cube_scan_matcher/core/online_matcher.h"
 #include "cube_scan_matcher/sim/motion.h"
@@ -118,25 +117,8 @@ Run simulate(const sim::Scene& scene, const sim::ScannerModel& model, const sim:
         scene, model, [&](double t) { return path.at(t) * mount; }, t_ref, duration, k % 2 == 1, rng);
     // Placed as tf would place it: T_odom_base(t) at constant velocity between the knots.
     // Ideal: placed with the true motion (what a perfect de-skew gives).
-    auto place = [&](const Eigen::Isometry3d& increment) {
-      const Twist xi = logMotion(increment);
-      PointArray placed;
-      placed.reserve(sweep.points.size());
-      std::size_t i = 0;
-      while (i < sweep.points.size()) {
-        std::size_t j = i;
-        while (j < sweep.points.size() && sweep.time[j] == sweep.time[i]) ++j;
-        const Eigen::Isometry3d to_ref = motionAt(xi, sweep.time[i], duration) * mount;
-        for (std::size_t n = i; n < j; ++n) {
-          const Eigen::Vector3d q = to_ref * sweep.points.point(n).cast<double>();
-          placed.push_back(float(q.x()), float(q.y()), float(q.z()));
-        }
-        i = j;
-      }
-      return placed;
-    };
-    run.moving.push_back(place(odom[k - 1].inverse() * odom[k]));
-    run.ideal.push_back(place(truth[k - 1].inverse() * truth[k]));
+    run.moving.push_back(sim::placeSweep(sweep, mount, odom[k - 1].inverse() * odom[k], duration));
+    run.ideal.push_back(sim::placeSweep(sweep, mount, truth[k - 1].inverse() * truth[k], duration));
     run.times.push_back(sweep.time);
     run.still.push_back(sim::scanInBody(scene, model, truth.back(), rng));
     run.truth.push_back(truth.back());

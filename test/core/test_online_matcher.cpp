@@ -4,7 +4,6 @@
 #include <algorithm>
 #include <random>
 
-#include "cube_scan_matcher/core/deskew.h"
 #include "cube_scan_matcher/core/online_matcher.h"
 #include "cube_scan_matcher/sim/motion.h"
 #include "cube_scan_matcher/sim/tilting_scanner.h"
@@ -296,12 +295,7 @@ std::vector<double> movingSweepErrors(bool deskew, std::vector<double>& angle_er
     const Eigen::Isometry3d odom_increment = increment * sim::randomTransform(rng, 1.0, 8.0);
     const sim::TimedSweep sweep = sim::scanDuringMotion(
         scene, sim::ScannerModel{}, [&](double t) { return path.at(t) * mount; }, k * d, d, k % 2 == 1, rng);
-    PointArray placed;
-    for (std::size_t i = 0; i < sweep.points.size(); ++i) {
-      const Eigen::Vector3d q = motionAt(logMotion(odom_increment), sweep.time[i], d) * mount *
-                                sweep.points.point(i).cast<double>();
-      placed.push_back(float(q.x()), float(q.y()), float(q.z()));
-    }
+    const PointArray placed = sim::placeSweep(sweep, mount, odom_increment, d);
     odom = odom * odom_increment;
     const PointTimes times{sweep.time, true};
     const OnlineStep step = m.process(placed, k * d, odom, &times);

@@ -32,8 +32,10 @@
 #include "cube_scan_matcher/ros/params.h"
 #include "cube_scan_matcher/ros/sweep_assembler_nodelet.h"
 #include "cube_scan_matcher/ros/transforms.h"
+#include "ros_test_helpers.h"
 
 using namespace cube_scan_matcher;
+using cube_scan_matcher::test::waitFor;
 
 namespace {
 
@@ -98,18 +100,6 @@ Eigen::Vector3d truePoint(int k, int i) {
   const Eigen::Isometry3d T = odomLaser(lineStart(k) + i * kTimeInc);
   return T * (double(publishedRange(k, i)) *
               Eigen::Vector3d(std::cos(beamAngle(i)), std::sin(beamAngle(i)), 0));
-}
-
-template <typename F>
-bool waitFor(F done, double timeout) {
-  const ros::WallTime end = ros::WallTime::now() + ros::WallDuration(timeout);
-  while (ros::ok() && ros::WallTime::now() < end) {
-    ros::spinOnce();
-    if (done()) return true;
-    ros::WallDuration(0.005).sleep();
-  }
-  ros::spinOnce();
-  return done();
 }
 
 std::string diagValue(const diagnostic_msgs::DiagnosticStatus& s, const std::string& key) {

@@ -75,6 +75,13 @@ TimedSweep scanDuringMotion(const Scene& scene, const ScannerModel& model,
                             double t_ref, double duration, bool tilt_up, std::mt19937_64& rng,
                             const SweepOptions& options = {});
 
+/// The sweep in the body frame at its reference time as tf would place it for a body moving
+/// at constant velocity with `increment` (T_body(t_ref - interval)^-1 T_body(t_ref)) over
+/// `interval` [s]: each point p (sensor frame at its time tau) goes to
+/// exp(tau / interval * log(increment)) * mount * p (core/deskew.h).
+PointArray placeSweep(const TimedSweep& sweep, const Eigen::Isometry3d& mount,
+                      const Eigen::Isometry3d& increment, double interval);
+
 /// One sweep from a robot at `body` (T_world_base) with the sensor mounted at the base's
 /// origin (sensorToBodyRotation()), returned in the base frame (REP-103 axes).
 PointArray scanInBody(const Scene& scene, const ScannerModel& model, const Eigen::Isometry3d& body,
