@@ -21,6 +21,7 @@ std::string toString(GateReason reason) {
     case GateReason::Unconfirmed: return "unconfirmed";
     case GateReason::Degenerate: return "degenerate";
     case GateReason::Uncertain: return "uncertain";
+    case GateReason::Ambiguous: return "ambiguous";
   }
   return "unknown";
 }
@@ -55,6 +56,7 @@ GateReason gate(const RegistrationResult& r, const Pose6& guess, const GateSetti
     return GateReason::CorrectionTooLarge;
   }
   if (s.require_polish && r.polish_tried && !r.polished) return GateReason::Unconfirmed;
+  if (s.reject_ambiguous && r.ambiguous) return GateReason::Ambiguous;
   if (s.reject_degenerate && r.polished && r.degenerate) return GateReason::Degenerate;
   if (s.max_sigma_m > 0.0 && r.polished && largestTranslationSigma(r.covariance) > s.max_sigma_m) {
     return GateReason::Uncertain;

@@ -14,6 +14,10 @@ void validate(const SearchSettings& s) {
   requireInRange("search starts", s.starts, 1, 64);
   requireInRange("search threads", s.threads, 1, 64);
   requireInRange("search retries", s.retries, 0, 8);
+  requireInRange("search axis_probe_m", s.axis_probe_m, 0.0, 5.0);
+  requireInRange("search axis_probe_gain", s.axis_probe_gain, 0.0, 1.0);
+  requireInRange("search ambiguous_weak_ratio", s.ambiguous_weak_ratio, 0.0, 1.0);
+  requireInRange("search ambiguous_max_agreeing", s.ambiguous_max_agreeing, 0, 64);
 }
 
 CoarseSearchResult coarseSearch(const std::vector<CoincidenceObjective*>& objectives,

@@ -19,6 +19,31 @@ namespace {
 /// A start agrees with the result when its coarse pose is this close [m], [rad].
 constexpr double kAgreeTranslation = 0.25;
 constexpr double kAgreeRotation = 0.03490658503988659;  // 2 deg
+/// Two polished results of an ambiguous scan agree within these [m], [rad] (0.5 deg).
+constexpr double kConsensusTranslation = 0.05;
+constexpr double kConsensusRotation = 0.008726646259971648;
+
+/// Within `t` [m] of translation and `r` [rad] on every rotation angle of each other.
+bool sameBasin(const Pose6& a, const Pose6& b, double t, double r) {
+  const Pose6 d = a - b;
+  double rot = 0.0;
+  for (int i = 3; i < 6; ++i) rot = std::max(rot, std::abs(wrapAngle(d[i])));
+  return d.head<3>().norm() <= t && rot <= r;
+}
+
+/// Starts whose coarse result lies near the final pose, and the best J of the others.
+void countAgreement(const std::vector<Pose6>& ranked, const std::vector<int>& ranked_J,
+                    RegistrationResult& res) {
+  res.starts_agreeing = 0;
+  res.J_runner_up = 0;
+  for (std::size_t k = 0; k < ranked.size(); ++k) {
+    if (sameBasin(ranked[k], res.pose, kAgreeTranslation, kAgreeRotation)) {
+      ++res.starts_agreeing;
+    } else {
+      res.J_runner_up = std::max(res.J_runner_up, ranked_J[k]);
+    }
+  }
+}
 
 using Clock = std::chrono::steady_clock;
 double seconds(Clock::time_point a, Clock::time_point b) {
@@ -32,6 +57,8 @@ RegistrationSettings RegistrationSettings::paper(double cube_edge) {
   s.gnmm.max_iterations = 500;
   s.search.starts = 1;
   s.search.threads = 1;
+  s.search.axis_probe_m = 0.0;
+  s.search.ambiguous_weak_ratio = 0.0;
   s.collapse_fraction = 0.0;
   s.dense_points = 0;
   s.refine.enabled = false;
@@ -306,6 +333,42 @@ void CubeRegistration::searchAttempt(const ScanPoints& points, const Pose6& gues
     objective.setScan(*points.full);
     res.J = objective(res.pose);
   }
+  if (res.polished && !res.degenerate && settings_.search.axis_probe_m > 0.0) {
+    const auto probe_start = Clock::now();
+    axisProbeStage(points, res);
+    res.time_polish_s += seconds(probe_start, Clock::now());
+  }
+}
+
+void CubeRegistration::axisProbeStage(const ScanPoints& points, RegistrationResult& res) const {
+  const SearchSettings& ss = settings_.search;
+  const double step = settings_.grid.cube_edge / 4.0;
+  CoincidenceObjective& objective = workspaces_[0]->coarse;  // bound to points.full
+  Pose6 best_pose = res.pose;
+  int best = res.J;
+  for (double d = step; d <= ss.axis_probe_m + 1e-9; d += step) {
+    for (const double sign : {-1.0, 1.0}) {
+      Pose6 q = res.pose;
+      q.head<3>() += sign * d * res.translation_weak_axis;
+      const int j = objective(q);
+      ++res.evaluations;
+      if (j > best) best = j, best_pose = q;
+    }
+  }
+  res.J_axis = best;
+  if (double(best) <= double(res.J) * (1.0 + ss.axis_probe_gain)) return;
+  // The search stopped short along the weak axis: polish again from the probe. (Not the
+  // refine: its compass search climbs back towards the first result on the fine grids, and
+  // the polish, weak along this axis by definition, then stays there.)
+  RegistrationResult moved = res;
+  moved.pose = best_pose;
+  polishStage(points, moved);
+  moved.J = objective(moved.pose);
+  res.evaluations = ++moved.evaluations;
+  if (moved.polished && moved.J > res.J) {
+    moved.axis_moved = true;
+    res = moved;
+  }
 }
 
 RegistrationResult CubeRegistration::align(const PointArray& scan, const Pose6& guess) const {
@@ -342,11 +405,11 @@ RegistrationResult CubeRegistration::align(const PointArray& scan, const Pose6& 
 
   // 2-4. Coarse search, refine, polish; again from new seeds while the result is not
   // confirmed (SearchSettings::retries).
-  std::vector<Pose6> ranked;  // the chosen attempt's starts' results, by decreasing J
-  std::vector<int> ranked_J;  // and their J
   const RegistrationResult before = res;
   double time_coarse = 0.0, time_refine = 0.0, time_polish = 0.0;
   int evaluations = 0, iterations = 0, restarts = 0, attempts = 0;
+  bool have = false, have_candidate = false;
+  RegistrationResult candidate;  // the best ambiguous result so far
   for (int attempt = 0; attempt <= ss.retries; ++attempt) {
     RegistrationResult r = before;
     std::vector<Pose6> r_ranked;
@@ -355,30 +418,36 @@ RegistrationResult CubeRegistration::align(const PointArray& scan, const Pose6& 
     ++attempts;
     time_coarse += r.time_coarse_s, time_refine += r.time_refine_s, time_polish += r.time_polish_s;
     evaluations += r.evaluations, iterations += r.iterations, restarts += r.restarts;
+    r.attempt_used = attempt;
+    // 5. Agreement of the starts with the result (ambiguity, for the acceptance gate).
+    countAgreement(r_ranked, r_ranked_J, r);
     const bool confirmed = !r.polish_tried || (r.polished && !r.degenerate);
-    if (attempt == 0 || confirmed) {
-      res = r;
-      res.attempt_used = attempt;
-      ranked = std::move(r_ranked);
-      ranked_J = std::move(r_ranked_J);
+    const bool ambiguous = confirmed && r.polished &&
+                           r.translation_weak_ratio < ss.ambiguous_weak_ratio &&
+                           r.starts_agreeing <= ss.ambiguous_max_agreeing;
+    if (attempt == 0) res = r;
+    if (confirmed && !ambiguous) {
+      res = r, have = true;
+      break;
     }
-    if (confirmed) break;
+    if (ambiguous) {
+      if (have_candidate && sameBasin(candidate.pose, r.pose, kConsensusTranslation, kConsensusRotation)) {
+        res = r.J >= candidate.J ? r : candidate;
+        res.consensus = true;
+        have = true;
+        break;
+      }
+      if (!have_candidate || r.J > candidate.J) candidate = r;
+      have_candidate = true;
+    }
+  }
+  if (!have && have_candidate) {
+    res = candidate;
+    res.ambiguous = true;
   }
   res.attempts = attempts;
   res.time_coarse_s = time_coarse, res.time_refine_s = time_refine, res.time_polish_s = time_polish;
   res.evaluations = evaluations, res.iterations = iterations, res.restarts = restarts;
-
-  // 5. Agreement of the starts with the result (ambiguity, for the acceptance gate).
-  for (std::size_t k = 0; k < ranked.size(); ++k) {
-    const Pose6 d = ranked[k] - res.pose;
-    Pose6 a = d;
-    for (int i = 3; i < 6; ++i) a[i] = wrapAngle(d[i]);
-    if (a.head<3>().norm() <= kAgreeTranslation && a.tail<3>().cwiseAbs().maxCoeff() <= kAgreeRotation) {
-      ++res.starts_agreeing;
-    } else {
-      res.J_runner_up = std::max(res.J_runner_up, ranked_J[k]);
-    }
-  }
 
   // 6. Finish: no objective keeps a pointer to this call's points.
   releaseScan();

@@ -37,6 +37,10 @@ void configToSettings(const ScanMatcherConfig& c, OnlineMatcherSettings& m) {
   r.gnmm.seed = std::uint64_t(c.seed);
   r.search.starts = c.starts;
   r.search.retries = c.retries;
+  r.search.axis_probe_m = c.axis_probe;
+  r.search.axis_probe_gain = c.axis_probe_gain;
+  r.search.ambiguous_weak_ratio = c.ambiguous_weak_ratio;
+  r.search.ambiguous_max_agreeing = c.ambiguous_max_agreeing;
   r.search.threads = c.threads;
   r.collapse_fraction = c.collapse_fraction;
   r.dense_points = c.dense_points;
@@ -55,6 +59,7 @@ void configToSettings(const ScanMatcherConfig& c, OnlineMatcherSettings& m) {
   m.gate.max_correction_rad = deg2rad(c.max_correction_rotation);
   m.gate.require_polish = c.require_polish;
   m.gate.reject_degenerate = c.reject_degenerate;
+  m.gate.reject_ambiguous = c.reject_ambiguous;
   m.gate.max_sigma_m = c.max_sigma_translation;
   m.max_consecutive_rejections = c.max_consecutive_rejections;
   m.keyframes.distance = c.keyframe_distance;
@@ -119,6 +124,10 @@ ScanMatcherConfig toConfig(const NodeParams& p) {
   c.seed = int(r.gnmm.seed);
   c.starts = r.search.starts;
   c.retries = r.search.retries;
+  c.axis_probe = r.search.axis_probe_m;
+  c.axis_probe_gain = r.search.axis_probe_gain;
+  c.ambiguous_weak_ratio = r.search.ambiguous_weak_ratio;
+  c.ambiguous_max_agreeing = r.search.ambiguous_max_agreeing;
   c.threads = r.search.threads;
   c.collapse_fraction = r.collapse_fraction;
   c.dense_points = r.dense_points;
@@ -137,6 +146,7 @@ ScanMatcherConfig toConfig(const NodeParams& p) {
   c.max_correction_rotation = rad2deg(p.matcher.gate.max_correction_rad);
   c.require_polish = p.matcher.gate.require_polish;
   c.reject_degenerate = p.matcher.gate.reject_degenerate;
+  c.reject_ambiguous = p.matcher.gate.reject_ambiguous;
   c.max_sigma_translation = p.matcher.gate.max_sigma_m;
   c.max_consecutive_rejections = p.matcher.max_consecutive_rejections;
   c.keyframe_distance = p.matcher.keyframes.distance;

@@ -40,6 +40,8 @@ void usage(std::ostream& os) {
         "  --sweep-interval S    [s] time between the two sweeps: what moves in crowd\n"
         "                        (default 2)\n"
         "  --worlds N            worlds (scene seeds 1..N) per scene type (default 20)\n"
+        "  --first-world F       scene seeds F..F+N-1 instead (default 1); a world's pairs do\n"
+        "                        not depend on the others\n"
         "  --trials N            start poses per world and motion (default 10)\n"
         "  --motions LIST        table1 (the paper's Table 1 motion of the scene type),\n"
         "                        random (1-5 m, +-45 deg yaw) (default table1,random)\n"
@@ -79,7 +81,8 @@ struct Row {
   double weak_ratio = 0.0, t_weak_ratio = 0.0;
   bool polished = false;
   double plane_rms = 0.0, plane_fraction = 0.0;
-  int agreeing = 0, J_runner_up = 0, J_coarse = 0, attempts = 1;
+  int agreeing = 0, J_runner_up = 0, J_coarse = 0, attempts = 1, J_axis = 0;
+  bool axis_moved = false, consensus = false;
   /// The largest |error| / sigma over the six axes (0 without a covariance).
   double maxZ() const {
     double z = 0.0;
@@ -120,7 +123,7 @@ int main(int argc, char** argv) {
   std::vector<std::string> scenes = {"hall", "urban", "park", "natural"};
   std::vector<std::string> motions = {"table1", "random"};
   std::vector<Bounds> bounds = {{"big", 1.0, 8.0}, {"small", 0.25, 2.0}};
-  int worlds = 20, trials = 10;
+  int worlds = 20, trials = 10, first_world = 1;
   std::uint64_t seed = 1;
   std::string csv_path = "scenes.csv";
   double check_success = -1, check_false_accepts = -1;
@@ -145,6 +148,7 @@ int main(int argc, char** argv) {
       if (a == "--scenes") scenes = sim::expandSceneNames(splitList(v));
       else if (a == "--sweep-interval") sweep_interval = io::parseNumber(a, v);
       else if (a == "--worlds") worlds = int(io::parseNumber(a, v));
+      else if (a == "--first-world") first_world = int(io::parseNumber(a, v));
       else if (a == "--trials") trials = int(io::parseNumber(a, v));
       else if (a == "--motions") motions = splitList(v);
       else if (a == "--initial-errors") {
@@ -167,7 +171,9 @@ int main(int argc, char** argv) {
       i += 2;
     }
     if (!(sweep_interval >= 0.0)) throw std::invalid_argument("--sweep-interval must be >= 0");
-    if (worlds < 1 || trials < 1) throw std::invalid_argument("--worlds and --trials must be >= 1");
+    if (worlds < 1 || trials < 1 || first_world < 1) {
+      throw std::invalid_argument("--worlds, --first-world and --trials must be >= 1");
+    }
     if (repeat < 1) throw std::invalid_argument("--repeat must be >= 1");
     if (check_rep_m >= 0 && repeat < 2)
       throw std::invalid_argument("--check-repeatability needs --repeat >= 2");
@@ -182,7 +188,7 @@ int main(int argc, char** argv) {
     csv << "scene,world,trial,motion,bounds,Es_m,Ea_deg,time_s,J,J_guess,J_truth,gate,success,"
            "ex_m,ey_m,ez_m,erx_rad,ery_rad,erz_rad,sx_m,sy_m,sz_m,srx_rad,sry_rad,srz_rad,"
            "degenerate,weak_ratio,polished,plane_rms_m,plane_fraction,"
-           "starts_agreeing,J_runner_up,J_coarse,t_weak_ratio,attempts\n";
+           "starts_agreeing,J_runner_up,J_coarse,t_weak_ratio,attempts,J_axis,axis_moved,consensus\n";
     CubeRegistration reg(settings);
     const GateSettings gate_settings;
     const sim::ScannerModel model = artefacts ? sim::scannerWithArtefacts() : sim::ScannerModel{};
@@ -191,7 +197,7 @@ int main(int argc, char** argv) {
     std::map<std::tuple<std::string, std::string, std::string>, std::vector<Repeatability>> reps;
     for (const std::string& scene_name : scenes) {
       const sim::SceneType type = sim::sceneTypeFromString(scene_name);
-      for (int w = 1; w <= worlds; ++w) {
+      for (int w = first_world; w < first_world + worlds; ++w) {
         sim::Scene world = sim::Scene::generate(type, std::uint64_t(w));
         std::mt19937_64 rng(seed * 1000003ULL + std::uint64_t(w) * 7919ULL + std::uint64_t(type));
         if (artefacts) {
@@ -224,6 +230,9 @@ int main(int argc, char** argv) {
               row.weak_ratio = r.weak_ratio;
               row.t_weak_ratio = r.translation_weak_ratio;
               row.attempts = r.attempts;
+              row.J_axis = r.J_axis;
+              row.axis_moved = r.axis_moved;
+              row.consensus = r.consensus;
               row.polished = r.polished;
               row.plane_rms = r.plane_rms;
               row.agreeing = r.starts_agreeing;
@@ -240,7 +249,7 @@ int main(int argc, char** argv) {
               csv << ',' << int(row.degenerate) << ',' << row.weak_ratio << ',' << int(row.polished)
                   << ',' << row.plane_rms << ',' << row.plane_fraction << ',' << row.agreeing << ','
                   << row.J_runner_up << ',' << row.J_coarse << ',' << row.t_weak_ratio << ','
-                  << row.attempts << '\n';
+                  << row.attempts << ',' << row.J_axis << ',' << int(row.axis_moved) << ',' << int(row.consensus) << '\n';
               rows.push_back(row);
               if (repeat > 1) {
                 std::vector<Eigen::Isometry3d> estimates{r.transform};
@@ -253,7 +262,8 @@ int main(int argc, char** argv) {
             }
           }
         }
-        std::fprintf(stderr, "%s: world %d of %d\n", scene_name.c_str(), w, worlds);
+        std::fprintf(stderr, "%s: world %d (%d of %d)\n", scene_name.c_str(), w,
+                     w - first_world + 1, worlds);
       }
     }
 

@@ -29,6 +29,12 @@ std::string algorithmOptionsHelp() {
          "                        (default " + std::to_string(d.search.starts) + "; paper 1)\n"
          "  --retries N           search again from new seeds while the polished result is\n"
          "                        degenerate or unconfirmed, up to N times (default " + std::to_string(d.search.retries) + ")\n"
+         "  --ambiguous R K       a result with a translation weak ratio below R that at most K\n"
+         "                        starts agree with counts only when a retry lands on it again\n"
+         "                        (default " + num(d.search.ambiguous_weak_ratio) + " " + std::to_string(d.search.ambiguous_max_agreeing) + "; 0 = off)\n"
+         "  --axis-probe M G      probe J along the weakest translation axis up to +-M [m] after\n"
+         "                        the polish; a J gain above G (fraction) moves the result there\n"
+         "                        (default " + num(d.search.axis_probe_m) + " m, " + num(d.search.axis_probe_gain) + "; 0 m = off)\n"
          "  --threads T           threads for the starts, the refine candidates and the grid\n"
          "                        builds (default " + std::to_string(d.search.threads) + ")\n"
          "  --simd P              vector path of the per-point loop: auto, avx512, avx2 or\n"
@@ -160,6 +166,10 @@ bool parseAlgorithmOption(const std::vector<std::string>& args, std::size_t& i,
     s.search.starts = int(value(1)), used = 2;
   } else if (a == "--retries") {
     s.search.retries = int(value(1)), used = 2;
+  } else if (a == "--ambiguous") {
+    s.search.ambiguous_weak_ratio = value(1), s.search.ambiguous_max_agreeing = int(value(2)), used = 3;
+  } else if (a == "--axis-probe") {
+    s.search.axis_probe_m = value(1), s.search.axis_probe_gain = value(2), used = 3;
   } else if (a == "--simd") {
     setSimdPath(parseSimdPath(word(1)));
     used = 2;

@@ -86,6 +86,23 @@ TEST(AcceptanceGate, RejectsUnconfirmedAndDegenerateResults) {
   EXPECT_EQ(toString(GateReason::Degenerate), "degenerate");
 }
 
+// A result marked ambiguous (no retry landed on it again) is rejected unless reject_ambiguous
+// is off; one confirmed by a consensus is not.
+TEST(AcceptanceGate, RejectsAnAmbiguousResult) {
+  RegistrationResult r = gainingResult();
+  r.polish_tried = r.polished = true;
+  const Pose6 guess = Pose6::Zero();
+  r.consensus = true;
+  EXPECT_EQ(gate(r, guess, GateSettings{}), GateReason::Accepted);
+  r.consensus = false;
+  r.ambiguous = true;
+  EXPECT_EQ(gate(r, guess, GateSettings{}), GateReason::Ambiguous);
+  GateSettings g;
+  g.reject_ambiguous = false;
+  EXPECT_EQ(gate(r, guess, g), GateReason::Accepted);
+  EXPECT_EQ(toString(GateReason::Ambiguous), "ambiguous");
+}
+
 // A polished result whose translation standard deviation (along any direction) exceeds
 // max_sigma_m is uncertain; 0 turns the check off.
 TEST(AcceptanceGate, RejectsResultsWithAWideCovariance) {

@@ -317,6 +317,12 @@ TEST(Registration, SettingsAreValidated) {
   s.refine.enabled = true;
   s.refine.edge_fraction = 1.5;
   EXPECT_THROW(CubeRegistration{s}, std::invalid_argument);
+  s = RegistrationSettings{};
+  s.search.axis_probe_m = -0.5;
+  EXPECT_THROW(CubeRegistration{s}, std::invalid_argument);
+  s = RegistrationSettings{};
+  s.search.axis_probe_gain = 2.0;
+  EXPECT_THROW(CubeRegistration{s}, std::invalid_argument);
 }
 
 }  // namespace
@@ -396,6 +402,7 @@ TEST(Registration, ATunnelIsFlaggedDegenerateAlongItsAxisAndRejected) {
     // Degenerate: the search ran again from new seeds (SearchSettings::retries), in vain.
     EXPECT_EQ(r.attempts, 1 + RegistrationSettings{}.search.retries);
     EXPECT_EQ(r.attempt_used, 0);
+    EXPECT_EQ(r.J_axis, 0);  // no axis probe on a degenerate result: nothing to find along it
   }
   // A confirmed result is not searched again.
   const Scans s = makeScans(sim::SceneType::Urban, 3);
@@ -404,4 +411,7 @@ TEST(Registration, ATunnelIsFlaggedDegenerateAlongItsAxisAndRejected) {
   const RegistrationResult u = urban.align(s.second, isometryToPose(s.T_first_second));
   EXPECT_TRUE(u.polished && !u.degenerate);
   EXPECT_EQ(u.attempts, 1);
+  // The axis probe ran (its best J is at least the result's) and found nothing better.
+  EXPECT_GE(u.J_axis, u.J);
+  EXPECT_FALSE(u.axis_moved);
 }

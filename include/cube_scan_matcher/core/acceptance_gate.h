@@ -24,6 +24,7 @@ enum class GateReason : std::uint8_t {
   Unconfirmed = 9,  ///< the point-to-plane polish did not confirm the cube result.
   Degenerate = 10,  ///< a direction of the result has (almost) no information.
   Uncertain = 11,   ///< the result's covariance is too wide.
+  Ambiguous = 12,   ///< weakly fixed, the starts disagree, and no retry landed on it again.
 };
 std::string toString(GateReason reason);
 
@@ -41,6 +42,11 @@ struct GateSettings {
   /// slide along such a direction; the odometry then carries the increment (scene benchmark:
   /// 5 of 11 wrong results, 2 of 1588 right ones; in a corridor every scan is rejected).
   bool reject_degenerate = true;
+  /// Reject a result marked ambiguous (RegistrationResult::ambiguous, SearchSettings::
+  /// ambiguous_weak_ratio): weakly fixed along a translation axis, most starts found other
+  /// maxima, and no retry landed on the same pose (robot worlds with the sensor's artefacts at
+  /// collapse 0.5: 3 of 7 wrong accepted results, BENCHMARK.md).
+  bool reject_ambiguous = true;
   /// Reject a polished result whose largest translation standard deviation (from its
   /// covariance, RegistrationResult::covariance, calibrated on the scene benchmark) exceeds
   /// this [m]; 0 = off. On the simulator right results have 0.3 cm median, 1.3 cm at most and

@@ -28,6 +28,24 @@ struct SearchSettings {
   /// paper's mode) or when the first result is confirmed. A scene that is degenerate
   /// (a tunnel) pays every retry. In [0, 8].
   int retries = 2;
+  /// Beyond the paper: after the polish, J on the E grid is probed along the weakest
+  /// translation axis of the result (PolishResult::translation_weak_axis, reference frame) at
+  /// +-E/4, +-E/2, ... up to +-axis_probe_m [m] (2 * 4 * axis_probe_m / E evaluations). Where
+  /// the scene fixes that axis only weakly (a wall along the track) the search can stop short
+  /// of the maximum along it; when the best probe beats the result's J by more than
+  /// axis_probe_gain (a fraction of J), the refine and the polish run again from the probe
+  /// and their result replaces the first if its J is higher. 0 = off. In [0, 5].
+  double axis_probe_m = 1.0;
+  /// The probe's J gain that moves the result: J_probe > J * (1 + gain). In [0, 1].
+  double axis_probe_gain = 0.03;
+  /// Beyond the paper: a confirmed result is ambiguous when its weakest translation axis is
+  /// weakly supported (PolishResult::translation_weak_ratio below ambiguous_weak_ratio) and at
+  /// most ambiguous_max_agreeing of the starts' coarse results lie near it (the others found
+  /// other maxima). It counts only when a retry lands on the same pose (within 5 cm and
+  /// 0.5 deg: a consensus); else the result is marked ambiguous (RegistrationResult::ambiguous,
+  /// rejected by the gate). 0 = off. In [0, 1] and [0, 64].
+  double ambiguous_weak_ratio = 0.03;
+  int ambiguous_max_agreeing = 1;
 };
 
 /// Throws std::invalid_argument naming the bad setting.

@@ -25,7 +25,7 @@ namespace cube_scan_matcher {
 // choice measured in BENCHMARK.md): RegistrationSettings{} is what the tools, the nodelet and
 // the README call "default", and RegistrationSettings::paper() is the paper's fixed mode.
 
-/// Shipped mode: the coarse stage at E = 0.5 m on the scan collapsed to one point per E/4
+/// Shipped mode: the coarse stage at E = 0.5 m on the scan collapsed to one point per E/2
 /// voxel, four GNMM starts of 300 iterations (15 vertices, restarts within +-1 m/+-8 deg), two
 /// at a time; the refine stage climbs the sum of J over three E/2 grids plus 3 x J on the E
 /// grid from the two best distinct coarse results; the polish moves the refined pose to the
@@ -39,8 +39,11 @@ struct RegistrationSettings {
   RefineSettings refine;  ///< the fine stage (off in the paper's mode).
   PolishSettings polish;  ///< the point-to-plane polish and covariance (off in the paper's mode).
   /// Beyond the paper: before the search, keep one scan point per voxel of edge
-  /// collapse_fraction * E. 0 = off, every point is evaluated (paper). In [0, 1].
-  double collapse_fraction = 0.25;
+  /// collapse_fraction * E. 0 = off, every point is evaluated (paper). In [0, 1]. E/2 since
+  /// session 12 (was E/4): 1.1-1.35x faster on the real pairs, as accurate on the scene
+  /// benchmark once the axis probe and the consensus rule catch the wall's slides
+  /// (BENCHMARK.md, "Weak axes").
+  double collapse_fraction = 0.5;
   /// Beyond the paper: the coarse search (and J_guess, J_coarse) uses only the scan points on
   /// densely sampled surfaces: those whose E-cube holds at least dense_points points of the
   /// scan (dense_sampling.h). Sparse far samples give J a false maximum at "no motion" (the scan
@@ -89,6 +92,14 @@ struct RegistrationResult {
   /// and the highest coarse J of the others (0 when every start agrees).
   int starts_agreeing = 0;
   int J_runner_up = 0;
+  /// The best J of the probe along the weakest translation axis (SearchSettings::axis_probe_m;
+  /// 0 when it did not run) and whether the result moved there (refined and polished again).
+  int J_axis = 0;
+  bool axis_moved = false;
+  /// SearchSettings::ambiguous_weak_ratio: the result was ambiguous and a retry landed on the
+  /// same pose (consensus), or no retry did (ambiguous: the gate rejects it).
+  bool consensus = false;
+  bool ambiguous = false;
   double time_s = 0.0;            ///< wall time of align() [s].
   double time_coarse_s = 0.0;     ///< of which the coarse stage (the GNMM starts) [s].
   double time_refine_s = 0.0;     ///< of which the refine stage [s].
@@ -175,6 +186,7 @@ class CubeRegistration {
                    RegistrationResult& res) const;
   void polishStage(const ScanPoints& points, RegistrationResult& res) const;
   /// Coarse, refine and polish stages from the seeds of `attempt` (0 = the first).
+  void axisProbeStage(const ScanPoints& points, RegistrationResult& res) const;
   void searchAttempt(const ScanPoints& points, const Pose6& guess, int attempt,
                      RegistrationResult& res, std::vector<Pose6>& ranked,
                      std::vector<int>& ranked_J) const;
