@@ -24,7 +24,8 @@ struct SearchSettings {
   /// planes or left the basin, or flags it degenerate: the wrong poses the search lands on
   /// from big starts are, a hall slid along its aisle), the search (coarse, refine, polish)
   /// runs again from new seeds (gnmm.seed + starts * attempt + k), up to `retries` more times;
-  /// the first confirmed result wins, else the first one. No retry without the polish (the
+  /// the first confirmed result wins (an ambiguous one only once a retry lands on it again:
+  /// ambiguous_weak_ratio), else the first one. No retry without the polish (the
   /// paper's mode) or when the first result is confirmed. A scene that is degenerate
   /// (a tunnel) pays every retry. In [0, 8].
   int retries = 2;

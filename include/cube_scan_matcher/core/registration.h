@@ -93,7 +93,7 @@ struct RegistrationResult {
   int starts_agreeing = 0;
   int J_runner_up = 0;
   /// The best J of the probe along the weakest translation axis (SearchSettings::axis_probe_m;
-  /// 0 when it did not run) and whether the result moved there (refined and polished again).
+  /// 0 when it did not run) and whether the result moved there (polished again from the probe).
   int J_axis = 0;
   bool axis_moved = false;
   /// SearchSettings::ambiguous_weak_ratio: the result was ambiguous and a retry landed on the
