@@ -51,4 +51,12 @@ double wrapAngle(double angle) {
   return angle <= -M_PI ? angle + 2.0 * M_PI : angle;
 }
 
+bool posesWithin(const Pose6& a, const Pose6& b, double translation_m, double rotation_rad) {
+  if ((a.head<3>() - b.head<3>()).norm() > translation_m) return false;
+  for (int i = 3; i < 6; ++i) {
+    if (std::abs(wrapAngle(a[i] - b[i])) > rotation_rad) return false;
+  }
+  return true;
+}
+
 }  // namespace cube_scan_matcher

@@ -28,9 +28,7 @@ void validate(const RefineSettings& s) {
 std::vector<Pose6> distinctCandidates(const std::vector<Pose6>& ranked,
                                       const RefineSettings& s) {
   auto same = [&s](const Pose6& a, const Pose6& b) {
-    const Pose6 d = a - b;
-    return d.head<3>().norm() <= s.distinct_translation &&
-           d.tail<3>().cwiseAbs().maxCoeff() <= s.distinct_rotation;
+    return posesWithin(a, b, s.distinct_translation, s.distinct_rotation);
   };
   std::vector<Pose6> kept;
   for (const Pose6& p : ranked) {

@@ -4,6 +4,7 @@
 #include <chrono>
 #include <memory>
 #include <mutex>
+#include <optional>
 #include <sstream>
 #include <stdexcept>
 
@@ -23,21 +24,13 @@ constexpr double kAgreeRotation = 0.03490658503988659;  // 2 deg
 constexpr double kConsensusTranslation = 0.05;
 constexpr double kConsensusRotation = 0.008726646259971648;
 
-/// Within `t` [m] of translation and `r` [rad] on every rotation angle of each other.
-bool sameBasin(const Pose6& a, const Pose6& b, double t, double r) {
-  const Pose6 d = a - b;
-  double rot = 0.0;
-  for (int i = 3; i < 6; ++i) rot = std::max(rot, std::abs(wrapAngle(d[i])));
-  return d.head<3>().norm() <= t && rot <= r;
-}
-
 /// Starts whose coarse result lies near the final pose, and the best J of the others.
 void countAgreement(const std::vector<Pose6>& ranked, const std::vector<int>& ranked_J,
                     RegistrationResult& res) {
   res.starts_agreeing = 0;
   res.J_runner_up = 0;
   for (std::size_t k = 0; k < ranked.size(); ++k) {
-    if (sameBasin(ranked[k], res.pose, kAgreeTranslation, kAgreeRotation)) {
+    if (posesWithin(ranked[k], res.pose, kAgreeTranslation, kAgreeRotation)) {
       ++res.starts_agreeing;
     } else {
       res.J_runner_up = std::max(res.J_runner_up, ranked_J[k]);
@@ -403,13 +396,13 @@ RegistrationResult CubeRegistration::align(const PointArray& scan, const Pose6& 
   prepareScan(scan, points);
   res.points_used = points.coarse->size();
 
-  // 2-4. Coarse search, refine, polish; again from new seeds while the result is not
+  // 2-5. Coarse search, refine, polish, agreement; again from new seeds while the result is not
   // confirmed (SearchSettings::retries).
   const RegistrationResult before = res;
   double time_coarse = 0.0, time_refine = 0.0, time_polish = 0.0;
   int evaluations = 0, iterations = 0, restarts = 0, attempts = 0;
-  bool have = false, have_candidate = false;
-  RegistrationResult candidate;  // the best ambiguous result so far
+  bool done = false;                          // a confirmed result was taken
+  std::optional<RegistrationResult> candidate;  // the best ambiguous result so far
   for (int attempt = 0; attempt <= ss.retries; ++attempt) {
     RegistrationResult r = before;
     std::vector<Pose6> r_ranked;
@@ -427,22 +420,20 @@ RegistrationResult CubeRegistration::align(const PointArray& scan, const Pose6& 
                            r.starts_agreeing <= ss.ambiguous_max_agreeing;
     if (attempt == 0) res = r;
     if (confirmed && !ambiguous) {
-      res = r, have = true;
+      res = r, done = true;
       break;
     }
-    if (ambiguous) {
-      if (have_candidate && sameBasin(candidate.pose, r.pose, kConsensusTranslation, kConsensusRotation)) {
-        res = r.J >= candidate.J ? r : candidate;
-        res.consensus = true;
-        have = true;
-        break;
-      }
-      if (!have_candidate || r.J > candidate.J) candidate = r;
-      have_candidate = true;
+    if (!ambiguous) continue;
+    if (candidate &&
+        posesWithin(candidate->pose, r.pose, kConsensusTranslation, kConsensusRotation)) {
+      res = r.J >= candidate->J ? r : *candidate;
+      res.consensus = true, done = true;
+      break;
     }
+    if (!candidate || r.J > candidate->J) candidate = r;
   }
-  if (!have && have_candidate) {
-    res = candidate;
+  if (!done && candidate) {
+    res = *candidate;
     res.ambiguous = true;
   }
   res.attempts = attempts;

@@ -45,7 +45,7 @@ struct GateSettings {
   /// Reject a result marked ambiguous (RegistrationResult::ambiguous, SearchSettings::
   /// ambiguous_weak_ratio): weakly fixed along a translation axis, most starts found other
   /// maxima, and no retry landed on the same pose (robot worlds with the sensor's artefacts at
-  /// collapse 0.5: 3 of 7 wrong accepted results, BENCHMARK.md).
+  /// collapse 0.5: it takes the wrongly accepted results from 7 to 3, BENCHMARK.md).
   bool reject_ambiguous = true;
   /// Reject a polished result whose largest translation standard deviation (from its
   /// covariance, RegistrationResult::covariance, calibrated on the scene benchmark) exceeds

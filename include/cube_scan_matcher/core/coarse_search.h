@@ -34,8 +34,8 @@ struct SearchSettings {
   /// +-E/4, +-E/2, ... up to +-axis_probe_m [m] (2 * 4 * axis_probe_m / E evaluations). Where
   /// the scene fixes that axis only weakly (a wall along the track) the search can stop short
   /// of the maximum along it; when the best probe beats the result's J by more than
-  /// axis_probe_gain (a fraction of J), the refine and the polish run again from the probe
-  /// and their result replaces the first if its J is higher. 0 = off. In [0, 5].
+  /// axis_probe_gain (a fraction of J), the polish runs again from the probe and its result
+  /// replaces the first if its J is higher. 0 = off. In [0, 5].
   double axis_probe_m = 1.0;
   /// The probe's J gain that moves the result: J_probe > J * (1 + gain). In [0, 1].
   double axis_probe_gain = 0.03;

@@ -27,6 +27,10 @@ Pose6 isometryToPose(const Eigen::Isometry3d& transform);
 /// Wraps an angle to (-pi, pi].
 double wrapAngle(double angle);
 
+/// Whether two poses lie within `translation_m` [m] of each other and within `rotation_rad`
+/// [rad] on each of roll, pitch and yaw (differences wrapped to (-pi, pi]).
+bool posesWithin(const Pose6& a, const Pose6& b, double translation_m, double rotation_rad);
+
 /// Degrees to radians.
 constexpr double deg2rad(double deg) { return deg * 0.017453292519943295; }
 /// Radians to degrees.
