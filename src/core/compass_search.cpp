@@ -22,25 +22,35 @@ CompassResult compassMaximize(const Objective6& f,
   r.best = initial;
   r.best_value = r.initial_value = f(initial);
   r.evaluations = 1;
+  constexpr int kDirections = 12;  // -step, +step along each of the 6 parameters
   Vector6d step = s.initial_step;
   for (int level = 0; level < s.levels; ++level, step *= 0.5) {
-    bool improved = true;
-    while (improved) {
-      improved = false;
-      for (int k = 0; k < 6; ++k) {
-        for (const double sign : {-1.0, 1.0}) {
-          if (r.evaluations >= s.max_evaluations) return r;
-          Vector6d q = r.best;
-          q[k] += sign * step[k];
-          const double v = f(q);
-          ++r.evaluations;
-          if (v > r.best_value) {
-            r.best = q;
-            r.best_value = v;
-            ++r.moves;
-            improved = true;
-          }
-        }
+    // The 12 directions are polled in a cycle and the level ends after 12 failures in a row:
+    // every point around the current best has then been polled. The point the last move came
+    // from is a known failure (its value is below the best) and is not evaluated again. The
+    // same moves as restarting the poll at direction 0 after each pass, without re-polling the
+    // directions that already failed around the same best.
+    int failures = 0;
+    int back = -1;  // the direction leading back to the point the last move left
+    for (int d = 0; failures < kDirections; d = (d + 1) % kDirections) {
+      if (d == back) {
+        ++failures;
+        continue;
+      }
+      if (r.evaluations >= s.max_evaluations) return r;
+      const int k = d / 2;
+      Vector6d q = r.best;
+      q[k] += (d % 2 ? 1.0 : -1.0) * step[k];
+      const double v = f(q);
+      ++r.evaluations;
+      if (v > r.best_value) {
+        r.best = q;
+        r.best_value = v;
+        ++r.moves;
+        failures = 0;
+        back = d ^ 1;
+      } else {
+        ++failures;
       }
     }
   }

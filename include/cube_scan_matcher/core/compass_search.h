@@ -28,8 +28,10 @@ struct CompassResult {
   int moves = 0;  ///< accepted steps
 };
 
-/// At each level, try +-step along each of the 6 axes from the current point, move to any
-/// strictly better point at once and repeat until no axis improves; then halve the steps.
+/// At each level, try -step and +step along each of the 6 axes in turn from the current point,
+/// move to any strictly better point at once, and go on around the axes until no axis
+/// improves; then halve the steps. No point is evaluated twice around the same best (and the
+/// point a move left is not evaluated again), so a level ends after 12 failures in a row.
 CompassResult compassMaximize(const Objective6& f,
                               const Vector6d& initial, const CompassSettings& settings);
 
