@@ -176,21 +176,23 @@ const PointArray* collapsed(const PointArray& scan, double fraction, double edge
 
 void CubeRegistration::prepareScan(const PointArray& scan, ScanPoints& p) const {
   const double edge = reference_->coarse.edge();
+  const double cf = settings_.collapse_fraction, rf = settings_.refine.collapse_fraction;
+  p.fine = collapsed(scan, rf, edge, p.fine_storage);
+  // A coarser set is collapsed from a finer one whose voxels nest in its own (the same points
+  // in the same order: the first of each voxel), which is a fraction of the points to hash.
+  auto from = [&](const PointArray& all, double fraction) -> const PointArray& {
+    return &all == &scan && rf > 0.0 && voxelsNest(fraction * edge, rf * edge) ? *p.fine : all;
+  };
   const PointArray& dense = *densePart(scan, settings_, edge, p.dense_storage);
-  p.coarse = collapsed(dense, settings_.collapse_fraction, edge, p.coarse_storage);
+  p.coarse = cf == rf && &dense == &scan ? p.fine
+                                         : collapsed(from(dense, cf), cf, edge, p.coarse_storage);
   p.full = &dense == &scan ? p.coarse
-                           : collapsed(scan, settings_.collapse_fraction, edge, p.full_storage);
-  p.fine = settings_.refine.collapse_fraction == settings_.collapse_fraction
-               ? p.full
-               : collapsed(scan, settings_.refine.collapse_fraction, edge, p.fine_storage);
+                           : collapsed(from(scan, cf), cf, edge, p.full_storage);
   if (!settings_.polish.enabled) return;
   const double pf = settings_.polish.collapse_fraction;
-  // A coarser polish set is collapsed from the refine's (fewer points to pass over).
-  const bool from_fine = pf > settings_.refine.collapse_fraction && settings_.refine.collapse_fraction > 0.0;
-  p.polish = pf == settings_.refine.collapse_fraction ? p.fine
-             : pf == settings_.collapse_fraction      ? p.full
-                                                      : collapsed(from_fine ? *p.fine : scan, pf,
-                                                                  edge, p.polish_storage);
+  p.polish = pf == rf   ? p.fine
+             : pf == cf ? p.full
+                        : collapsed(from(scan, pf), pf, edge, p.polish_storage);
 }
 
 void CubeRegistration::releaseScan() const {

@@ -27,4 +27,14 @@ PointArray collapseToVoxels(const PointArray& in, double voxel) {
   return out;
 }
 
+bool voxelsNest(double coarse, double fine) {
+  if (!(coarse > 0.0 && fine > 0.0)) return false;
+  // The keys use float(1 / edge): floor(v * 2^k inv) / 2^k = floor(v * inv) when the fine
+  // inverse is 2^k times the coarse one (k >= 0), and v * 2^k inv is exact.
+  const float inv_coarse = float(1.0 / coarse), inv_fine = float(1.0 / fine);
+  int exponent = 0;
+  const float mantissa = std::frexp(inv_fine / inv_coarse, &exponent);
+  return mantissa == 0.5f && exponent >= 1 && inv_fine == std::ldexp(inv_coarse, exponent - 1);
+}
+
 }  // namespace cube_scan_matcher

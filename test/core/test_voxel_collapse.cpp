@@ -17,3 +17,29 @@ TEST(VoxelCollapse, KeepsOnePointPerVoxel) {
   EXPECT_FLOAT_EQ(out.x[0], 0.f);  // the first point of a voxel is kept
   EXPECT_THROW(collapseToVoxels(in, 0.0), std::invalid_argument);
 }
+
+TEST(VoxelCollapse, NestedVoxelsCollapseFromTheFinerResultToTheSamePoints) {
+  EXPECT_TRUE(voxelsNest(0.25, 0.125));   // E/2 and E/4 at E = 0.5
+  EXPECT_TRUE(voxelsNest(0.15, 0.075));   // at E = 0.3: not exact decimals, still nested
+  EXPECT_TRUE(voxelsNest(0.4, 0.05));     // 2^3
+  EXPECT_TRUE(voxelsNest(0.125, 0.125));  // 2^0
+  EXPECT_FALSE(voxelsNest(0.25, 0.1));
+  EXPECT_FALSE(voxelsNest(0.3, 0.2));
+  EXPECT_FALSE(voxelsNest(0.125, 0.25));  // the finer voxel must be the second
+  EXPECT_FALSE(voxelsNest(0.0, 0.125));
+  // Points on and around voxel boundaries, on both sides of the origin.
+  PointArray in;
+  for (int i = 0; i < 20000; ++i) {
+    const float u = float((i * 7919) % 4001 - 2000) * 0.00371f;
+    in.push_back(u, 0.5f * u - 0.075f * float(i % 9), float(i % 13) * 0.0375f - 0.2f);
+  }
+  for (const double edge : {0.5, 0.3}) {
+    const PointArray fine = collapseToVoxels(in, edge / 4);
+    const PointArray direct = collapseToVoxels(in, edge / 2);
+    const PointArray nested = collapseToVoxels(fine, edge / 2);
+    ASSERT_LT(direct.size(), fine.size());
+    EXPECT_EQ(direct.x, nested.x) << "E = " << edge;
+    EXPECT_EQ(direct.y, nested.y);
+    EXPECT_EQ(direct.z, nested.z);
+  }
+}

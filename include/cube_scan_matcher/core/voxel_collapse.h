@@ -11,4 +11,11 @@ namespace cube_scan_matcher {
 /// order is already spatially coherent). O(n) with an open-addressing hash.
 PointArray collapseToVoxels(const PointArray& points, double voxel);
 
+/// Whether every voxel of edge `fine` [m] lies inside one voxel of edge `coarse` [m] as
+/// collapseToVoxels() cuts space (the coarse edge is the fine one times a power of two, exactly
+/// in the float arithmetic of the keys). Then collapsing the fine result at `coarse` gives the
+/// same points in the same order as collapsing the input at `coarse`, for points within
+/// +-2^20 fine voxels of the origin (131 km at 0.125 m). False for an edge <= 0.
+bool voxelsNest(double coarse, double fine);
+
 }  // namespace cube_scan_matcher
