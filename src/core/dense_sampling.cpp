@@ -8,19 +8,20 @@
 
 namespace cube_scan_matcher {
 
-using detail::KeySet;
 
 PointArray keepDenselySampled(const PointArray& points, double edge, int min_points,
                               DenseSamplingStats* stats) {
   if (!(edge > 0.0)) throw std::invalid_argument("dense sampling: cube edge must be > 0 m");
   if (min_points < 1) throw std::invalid_argument("dense sampling: min_points must be >= 1");
   const float inv = float(1.0 / edge);
-  KeySet set(points.size());
-  std::vector<std::uint32_t> count(set.capacity(), 0);  // points per cube, by slot
+  detail::KeyIndex set(points.size() / 8);
+  std::vector<std::uint32_t> count;  // points per cube, by the cube's index
   std::vector<std::uint32_t> slot(points.size());
   for (std::size_t i = 0; i < points.size(); ++i) {
-    slot[i] = std::uint32_t(set.insert(detail::voxelKey(points.x[i], points.y[i], points.z[i], inv)).first);
-    ++count[slot[i]];
+    const auto [index, added] = set.insert(detail::voxelKey(points.x[i], points.y[i], points.z[i], inv));
+    if (added) count.push_back(0);
+    slot[i] = index;
+    ++count[index];
   }
   PointArray out;
   out.reserve(points.size());

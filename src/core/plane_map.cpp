@@ -10,7 +10,6 @@
 namespace cube_scan_matcher {
 
 namespace {
-constexpr std::uint32_t kNoIndex = ~std::uint32_t{0};
 constexpr std::int64_t kMaxIndex = (std::int64_t{1} << 21) - 1;
 }  // namespace
 
@@ -27,17 +26,20 @@ PlaneMap::PlaneMap(const PointArray& reference, double voxel, int min_points,
       min_spread_(min_spread),
       max_planarity_(max_planarity) {
   if (!(voxel > 0.0)) throw std::invalid_argument("plane map voxel must be > 0 m");
-  keys_ = std::make_unique<detail::KeySet>(reference.size());
-  slot_to_index_.assign(keys_->capacity(), kNoIndex);
+  keys_ = std::make_unique<detail::KeyIndex>(reference.size() / 8);
+  // Two passes: the voxel of every point, then the sums in one allocation (growing a vector of
+  // 104-byte sums would copy it over and over).
+  std::vector<std::uint32_t> voxel_of(reference.size(), detail::KeyIndex::kNone);
   for (std::size_t i = 0; i < reference.size(); ++i) {
     const float x = reference.x[i], y = reference.y[i], z = reference.z[i];
     if (!std::isfinite(x) || !std::isfinite(y) || !std::isfinite(z)) continue;
-    const auto [slot, added] = keys_->insert(detail::voxelKey(x, y, z, inv_));
-    if (added) {
-      slot_to_index_[slot] = std::uint32_t(stats_.size());
-      stats_.emplace_back();
-    }
-    Stats& s = stats_[slot_to_index_[slot]];
+    voxel_of[i] = keys_->insert(detail::voxelKey(x, y, z, inv_)).first;
+  }
+  stats_.assign(keys_->size(), Stats());
+  for (std::size_t i = 0; i < reference.size(); ++i) {
+    if (voxel_of[i] == detail::KeyIndex::kNone) continue;
+    const float x = reference.x[i], y = reference.y[i], z = reference.z[i];
+    Stats& s = stats_[voxel_of[i]];
     const Eigen::Vector3d p(x, y, z);
     s.n += 1.0;
     s.sum += p;
@@ -56,9 +58,9 @@ void PlaneMap::fit(std::size_t index, std::int64_t ix, std::int64_t iy, std::int
         if (jx < 0 || jy < 0 || jz < 0 || jx > kMaxIndex || jy > kMaxIndex || jz > kMaxIndex) {
           continue;
         }
-        const std::size_t slot = keys_->find(detail::packVoxel(jx, jy, jz));
-        if (slot == keys_->capacity()) continue;
-        const Stats& s = stats_[slot_to_index_[slot]];
+        const std::uint32_t j = keys_->find(detail::packVoxel(jx, jy, jz));
+        if (j == detail::KeyIndex::kNone) continue;
+        const Stats& s = stats_[j];
         block.n += s.n;
         block.sum += s.sum;
         block.outer += s.outer;
@@ -89,16 +91,14 @@ const LocalPlane* PlaneMap::planeAt(const Eigen::Vector3d& q) const {
   const std::int64_t ix = detail::voxelIndex(float(q.x()), inv_);
   const std::int64_t iy = detail::voxelIndex(float(q.y()), inv_);
   const std::int64_t iz = detail::voxelIndex(float(q.z()), inv_);
-  const std::size_t slot = keys_->find(detail::packVoxel(ix, iy, iz));
-  if (slot == keys_->capacity()) return nullptr;
-  const std::size_t index = slot_to_index_[slot];
+  const std::uint32_t index = keys_->find(detail::packVoxel(ix, iy, iz));
+  if (index == detail::KeyIndex::kNone) return nullptr;
   if (fit_[index] == Fit::Unknown) fit(index, ix, iy, iz);
   return fit_[index] == Fit::Plane ? &planes_[index] : nullptr;
 }
 
 std::size_t PlaneMap::memoryBytes() const {
-  return (keys_ ? keys_->capacity() * sizeof(std::uint64_t) : 0) +
-         slot_to_index_.capacity() * sizeof(std::uint32_t) + stats_.capacity() * sizeof(Stats) +
+  return (keys_ ? keys_->memoryBytes() : 0) + stats_.capacity() * sizeof(Stats) +
          fit_.capacity() * sizeof(Fit) + planes_.capacity() * sizeof(LocalPlane);
 }
 

@@ -15,9 +15,10 @@ using detail::voxelKey;
 PointArray collapseToVoxels(const PointArray& in, double voxel) {
   if (!(voxel > 0.0)) throw std::invalid_argument("collapse voxel must be > 0 m");
   const float inv = float(1.0 / voxel);
-  detail::KeySet set(in.size());
+  // A tilting scanner's sweep has some 10 points per E/4 voxel: the map starts there.
+  detail::KeyIndex set(in.size() / 8);
   std::vector<std::uint32_t> keep;
-  keep.reserve(in.size());
+  keep.reserve(in.size() / 8);
   for (std::size_t i = 0; i < in.size(); ++i) {
     if (set.insert(voxelKey(in.x[i], in.y[i], in.z[i], inv)).second) keep.push_back(std::uint32_t(i));
   }

@@ -35,37 +35,67 @@ inline std::uint64_t mixKey(std::uint64_t k) {
   return k;
 }
 
-/// Open-addressing hash set of packed keys (linear probing), sized for `n` distinct keys.
-class KeySet {
+/// Open-addressing hash map (linear probing) from packed keys to their insertion order
+/// 0, 1, 2, ...: the index of a voxel in arrays the caller keeps. It starts small and doubles
+/// when half full, so its memory follows the voxels, not the points (a table sized for every
+/// point of a 64k-point scan was 1.5 MB to clear and fault in, most of a plane map's build).
+class KeyIndex {
  public:
-  explicit KeySet(std::size_t n) {
-    while (cap_ < 2 * n) cap_ <<= 1;
-    table_.assign(cap_, kEmpty);
+  static constexpr std::uint32_t kNone = ~std::uint32_t{0};
+
+  /// `expected`: a guess of the number of keys (the table grows past it).
+  explicit KeyIndex(std::size_t expected = 0) { rehash(expected); }
+  /// The index of `key`, added as the next index if new; and whether it was new.
+  std::pair<std::uint32_t, bool> insert(std::uint64_t key) {
+    std::size_t h = mixKey(key) & (cap_ - 1);
+    for (;; h = (h + 1) & (cap_ - 1)) {
+      if (keys_[h] == key) return {index_[h], false};
+      if (keys_[h] == kEmpty) break;
+    }
+    if (2 * (size_ + 1) > cap_) {
+      rehash(2 * (std::size_t(size_) + 1));  // doubles the table
+      return insert(key);
+    }
+    keys_[h] = key;
+    index_[h] = size_;
+    return {size_++, true};
   }
-  /// Inserts `key` if new. Returns its slot and whether it was new.
-  std::pair<std::size_t, bool> insert(std::uint64_t key) {
+  /// The index of `key`, or kNone.
+  std::uint32_t find(std::uint64_t key) const {
     for (std::size_t h = mixKey(key) & (cap_ - 1);; h = (h + 1) & (cap_ - 1)) {
-      if (table_[h] == key) return {h, false};
-      if (table_[h] == kEmpty) {
-        table_[h] = key;
-        return {h, true};
-      }
+      if (keys_[h] == key) return index_[h];
+      if (keys_[h] == kEmpty) return kNone;
     }
   }
-  /// The slot of `key`, or capacity() when it is not in the set.
-  std::size_t find(std::uint64_t key) const {
-    for (std::size_t h = mixKey(key) & (cap_ - 1);; h = (h + 1) & (cap_ - 1)) {
-      if (table_[h] == key) return h;
-      if (table_[h] == kEmpty) return cap_;
-    }
+  std::uint32_t size() const { return size_; }
+  std::size_t memoryBytes() const {
+    return keys_.capacity() * sizeof(std::uint64_t) + index_.capacity() * sizeof(std::uint32_t);
   }
-  /// Slots of the table: insert() returns one of [0, capacity()).
-  std::size_t capacity() const { return cap_; }
 
  private:
   static constexpr std::uint64_t kEmpty = ~std::uint64_t{0};  // no packed key has bit 63 set
-  std::size_t cap_ = 64;
-  std::vector<std::uint64_t> table_;
+  /// A table of at least 64 slots and at least 2 * n, with every key re-inserted.
+  void rehash(std::size_t n) {
+    std::size_t cap = 64;
+    while (cap < 2 * n) cap <<= 1;
+    std::vector<std::uint64_t> keys(cap, kEmpty);
+    std::vector<std::uint32_t> index(cap, kNone);
+    for (std::size_t s = 0; s < keys_.size(); ++s) {
+      if (keys_[s] == kEmpty) continue;
+      std::size_t h = mixKey(keys_[s]) & (cap - 1);
+      while (keys[h] != kEmpty) h = (h + 1) & (cap - 1);
+      keys[h] = keys_[s];
+      index[h] = index_[s];
+    }
+    keys_.swap(keys);
+    index_.swap(index);
+    cap_ = cap;
+  }
+
+  std::size_t cap_ = 0;
+  std::uint32_t size_ = 0;
+  std::vector<std::uint64_t> keys_;
+  std::vector<std::uint32_t> index_;
 };
 
 }  // namespace cube_scan_matcher::detail

@@ -18,7 +18,7 @@
 namespace cube_scan_matcher {
 
 namespace detail {
-class KeySet;
+class KeyIndex;
 }
 
 /// A plane fitted to reference points: n . (q - mean) is the signed distance of q [m].
@@ -69,8 +69,7 @@ class PlaneMap {
   int min_points_ = 5;
   double min_spread_ = 0.0;
   double max_planarity_ = 0.1;
-  std::unique_ptr<detail::KeySet> keys_;
-  std::vector<std::uint32_t> slot_to_index_;  // KeySet slot -> index into stats_
+  std::unique_ptr<detail::KeyIndex> keys_;  // voxel key -> index into stats_
   std::vector<Stats> stats_;
   mutable std::vector<Fit> fit_;
   mutable std::vector<LocalPlane> planes_;
