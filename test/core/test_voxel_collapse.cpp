@@ -43,3 +43,17 @@ TEST(VoxelCollapse, NestedVoxelsCollapseFromTheFinerResultToTheSamePoints) {
     EXPECT_EQ(direct.z, nested.z);
   }
 }
+
+TEST(VoxelCollapse, KeepsEveryVoxelWhenThereAreAsManyAsPoints) {
+  // Every point in its own voxel: the voxel map starts at an eighth of the points and grows
+  // several times; nothing may be lost or merged on the way.
+  PointArray in;
+  for (int i = 0; i < 60000; ++i) in.push_back(float(i % 50), float((i / 50) % 40), float(i / 2000));
+  for (int i = 0; i < 60000; i += 7) in.push_back(float(i % 50) + 0.1f, float((i / 50) % 40), float(i / 2000));
+  const PointArray out = collapseToVoxels(in, 0.5);
+  ASSERT_EQ(out.size(), 60000u);
+  for (std::size_t i = 0; i < out.size(); ++i) {
+    ASSERT_EQ(out.x[i], in.x[i]);  // the first point of each voxel, in input order
+    ASSERT_EQ(out.z[i], in.z[i]);
+  }
+}
