@@ -209,14 +209,23 @@ void computeCubeIndices(const GridAffine& g, const Eigen::Vector3f& dims, const 
 }
 
 CubeGrid CubeGrid::build(const PointArray& ref, const CubeGridSettings& settings) {
+  CubeGrid g;
+  g.rebuild(ref, settings);
+  return g;
+}
+
+void CubeGrid::rebuild(const PointArray& ref, const CubeGridSettings& settings) {
   validate(settings);
+  // Empty until it is complete: an error leaves no half-built grid.
+  list_.clear();
+  bits_.clear();
+  dims_.setZero();
+  dims_f_.setZero();
   if (ref.empty()) {
     throw CubeGridError(CubeGridError::Code::EmptyReference,
                         "reference scan has no points after filtering");
   }
-  CubeGrid g;
-  g.edge_ = settings.cube_edge;
-  g.max_byte_cubes_ = settings.max_byte_cubes;
+  const double edge = settings.cube_edge;
   Eigen::Vector3d lo = Eigen::Vector3d::Constant(std::numeric_limits<double>::infinity());
   Eigen::Vector3d hi = -lo;
   for (std::size_t i = 0; i < ref.size(); ++i) {
@@ -228,47 +237,56 @@ CubeGrid CubeGrid::build(const PointArray& ref, const CubeGridSettings& settings
     lo = lo.cwiseMin(p);
     hi = hi.cwiseMax(p);
   }
-  lo.array() -= settings.origin_shift * g.edge_;
-  g.min_ = lo;
-  g.max_ = hi;
+  lo.array() -= settings.origin_shift * edge;
   // Nx = round((xmax - xmin)/E) + 1 (eq. 4 plus the inclusive upper bound). Checked in double
   // before anything is allocated, so an absurd extent is an error and not a bad_alloc.
-  const Eigen::Vector3d n = ((hi - lo) / g.edge_).array().round() + 1.0;
+  const Eigen::Vector3d n = ((hi - lo) / edge).array().round() + 1.0;
   const double v = n.x() * n.y() * n.z();
   if (!(v <= double(settings.max_cubes))) {
     std::ostringstream os;
     os << "cube grid too large: reference extent " << (hi - lo).x() << " x " << (hi - lo).y()
-       << " x " << (hi - lo).z() << " m at E = " << g.edge_ << " m needs " << v
+       << " x " << (hi - lo).z() << " m at E = " << edge << " m needs " << v
        << " cubes, above max_cubes = " << settings.max_cubes
        << " (raise max_cubes or cube_edge, or lower max_range)";
     throw CubeGridError(CubeGridError::Code::TooManyCubes, os.str());
   }
   // The float kernel decides the index of every point, so the dims are taken from it too:
   // +1 cube of slack guarantees that float rounding of the max corner stays inside.
-  const GridAffine id = g.affine(Eigen::Matrix3f::Identity(), Eigen::Vector3f::Zero());
+  const GridAffine id = makeAffine(Eigen::Matrix3f::Identity(), Eigen::Vector3f::Zero(), lo, edge);
+  Eigen::Vector3i dims;
   for (int k = 0; k < 3; ++k) {
     const float top = float(hi[k]) * id.a[k][k] + id.b[k];
-    g.dims_[k] = std::max(int(n[k]), int(std::floor(top)) + 1);
+    dims[k] = std::max(int(n[k]), int(std::floor(top)) + 1);
   }
-  if (double(g.dims_.x()) * g.dims_.y() * g.dims_.z() > double(settings.max_cubes)) {
+  if (double(dims.x()) * dims.y() * dims.z() > double(settings.max_cubes)) {
     throw CubeGridError(CubeGridError::Code::TooManyCubes,
                         "cube grid too large after rounding; raise max_cubes or cube_edge");
   }
-  g.dims_f_ = g.dims_.cast<float>();
-  g.bits_.assign((g.cubeCount() + 63) / 64, 0);
-  std::vector<std::int32_t> idx(ref.size());
-  computeCubeIndices(id, g.dims_f_, ref.x.data(), ref.y.data(), ref.z.data(), ref.size(), -1,
-                     idx.data());
-  for (std::int32_t i : idx) {
-    if (i < 0) continue;  // cannot happen for points inside their own box; kept for safety
-    std::uint64_t& w = g.bits_[std::size_t(i) >> 6];
-    const std::uint64_t bit = std::uint64_t{1} << (i & 63);
-    if (!(w & bit)) {
-      w |= bit;
-      g.list_.push_back(i);
+  edge_ = edge;
+  max_byte_cubes_ = settings.max_byte_cubes;
+  min_ = lo;
+  max_ = hi;
+  dims_ = dims;
+  dims_f_ = dims_.cast<float>();
+  bits_.assign((cubeCount() + 63) / 64, 0);
+  // Indices a block at a time (no index array the size of the scan to allocate).
+  constexpr std::size_t kBlock = 1024;
+  std::int32_t idx[kBlock];
+  for (std::size_t begin = 0; begin < ref.size(); begin += kBlock) {
+    const std::size_t m = std::min(kBlock, ref.size() - begin);
+    computeCubeIndices(id, dims_f_, ref.x.data() + begin, ref.y.data() + begin,
+                       ref.z.data() + begin, m, -1, idx);
+    for (std::size_t k = 0; k < m; ++k) {
+      const std::int32_t i = idx[k];
+      if (i < 0) continue;  // cannot happen for points inside their own box; kept for safety
+      std::uint64_t& w = bits_[std::size_t(i) >> 6];
+      const std::uint64_t bit = std::uint64_t{1} << (i & 63);
+      if (!(w & bit)) {
+        w |= bit;
+        list_.push_back(i);
+      }
     }
   }
-  return g;
 }
 
 std::int64_t CubeGrid::index(const Eigen::Vector3f& p) const {

@@ -19,34 +19,43 @@ PlaneMap::PlaneMap(PlaneMap&&) noexcept = default;
 PlaneMap& PlaneMap::operator=(PlaneMap&&) noexcept = default;
 
 PlaneMap::PlaneMap(const PointArray& reference, double voxel, int min_points,
-                   double max_planarity, double min_spread)
-    : voxel_(voxel),
-      inv_(float(1.0 / voxel)),
-      min_points_(min_points),
-      min_spread_(min_spread),
-      max_planarity_(max_planarity) {
+                   double max_planarity, double min_spread) {
+  rebuild(reference, voxel, min_points, max_planarity, min_spread);
+}
+
+void PlaneMap::rebuild(const PointArray& reference, double voxel, int min_points,
+                       double max_planarity, double min_spread) {
+  stats_.clear();  // empty (planeAt() finds nothing) until complete
   if (!(voxel > 0.0)) throw std::invalid_argument("plane map voxel must be > 0 m");
-  keys_ = std::make_unique<detail::KeyIndex>(reference.size() / 8);
+  voxel_ = voxel;
+  inv_ = float(1.0 / voxel);
+  min_points_ = min_points;
+  min_spread_ = min_spread;
+  max_planarity_ = max_planarity;
+  if (!keys_) keys_ = std::make_unique<detail::KeyIndex>();
+  keys_->reset(reference.size() / 8);
   // Two passes: the voxel of every point, then the sums in one allocation (growing a vector of
   // 104-byte sums would copy it over and over).
-  std::vector<std::uint32_t> voxel_of(reference.size(), detail::KeyIndex::kNone);
+  voxel_of_.assign(reference.size(), detail::KeyIndex::kNone);
   for (std::size_t i = 0; i < reference.size(); ++i) {
     const float x = reference.x[i], y = reference.y[i], z = reference.z[i];
     if (!std::isfinite(x) || !std::isfinite(y) || !std::isfinite(z)) continue;
-    voxel_of[i] = keys_->insert(detail::voxelKey(x, y, z, inv_)).first;
+    voxel_of_[i] = keys_->insert(detail::voxelKey(x, y, z, inv_)).first;
   }
-  stats_.assign(keys_->size(), Stats());
+  std::vector<Stats> stats;
+  stats.swap(stats_);
+  stats.assign(keys_->size(), Stats());
   for (std::size_t i = 0; i < reference.size(); ++i) {
-    if (voxel_of[i] == detail::KeyIndex::kNone) continue;
-    const float x = reference.x[i], y = reference.y[i], z = reference.z[i];
-    Stats& s = stats_[voxel_of[i]];
-    const Eigen::Vector3d p(x, y, z);
+    if (voxel_of_[i] == detail::KeyIndex::kNone) continue;
+    Stats& s = stats[voxel_of_[i]];
+    const Eigen::Vector3d p(reference.x[i], reference.y[i], reference.z[i]);
     s.n += 1.0;
     s.sum += p;
     s.outer += p * p.transpose();
   }
-  fit_.assign(stats_.size(), Fit::Unknown);
-  planes_.resize(stats_.size());
+  fit_.assign(stats.size(), Fit::Unknown);
+  planes_.resize(stats.size());
+  stats_.swap(stats);
 }
 
 void PlaneMap::fit(std::size_t index, std::int64_t ix, std::int64_t iy, std::int64_t iz) const {
@@ -99,6 +108,7 @@ const LocalPlane* PlaneMap::planeAt(const Eigen::Vector3d& q) const {
 
 std::size_t PlaneMap::memoryBytes() const {
   return (keys_ ? keys_->memoryBytes() : 0) + stats_.capacity() * sizeof(Stats) +
+         voxel_of_.capacity() * sizeof(std::uint32_t) +
          fit_.capacity() * sizeof(Fit) + planes_.capacity() * sizeof(LocalPlane);
 }
 

@@ -9,6 +9,15 @@ namespace cube_scan_matcher {
 ReferenceGrids buildReferenceGrids(const PointArray& reference, const CubeGridSettings& grid,
                                    int fine_grids, double fine_edge_fraction, int threads,
                                    const PlaneMapSettings& planes) {
+  ReferenceGrids r;
+  rebuildReferenceGrids(r, reference, grid, fine_grids, fine_edge_fraction, threads, planes);
+  return r;
+}
+
+void rebuildReferenceGrids(ReferenceGrids& r, const PointArray& reference,
+                           const CubeGridSettings& grid, int fine_grids,
+                           double fine_edge_fraction, int threads,
+                           const PlaneMapSettings& planes) {
   // specs[0] is the E grid, the rest are the fine grids.
   std::vector<CubeGridSettings> specs{grid};
   CubeGridSettings gs = grid;
@@ -17,31 +26,27 @@ ReferenceGrids buildReferenceGrids(const PointArray& reference, const CubeGridSe
     gs.origin_shift = double(k) / fine_grids;
     specs.push_back(gs);
   }
-  std::vector<CubeGrid> grids(specs.size());
+  r.fine.resize(specs.size() - 1);
+  auto grid_of = [&r](std::size_t k) -> CubeGrid& { return k == 0 ? r.coarse : r.fine[k - 1]; };
   // The plane map is the last job, built beside the grids.
   const int jobs = int(specs.size()) + (planes.enabled ? 1 : 0);
   std::vector<std::exception_ptr> errors(static_cast<std::size_t>(jobs));
-  PlaneMap plane_map;
   runOnThreads(jobs, threads, [&](int k, int) {
     try {
       if (k == int(specs.size())) {
-        plane_map = PlaneMap(reference, planes.voxel, planes.min_points, planes.max_planarity,
-                             planes.min_spread);
+        r.planes.rebuild(reference, planes.voxel, planes.min_points, planes.max_planarity,
+                         planes.min_spread);
       } else {
-        grids[std::size_t(k)] = CubeGrid::build(reference, specs[std::size_t(k)]);
+        grid_of(std::size_t(k)).rebuild(reference, specs[std::size_t(k)]);
       }
     } catch (...) {
       errors[std::size_t(k)] = std::current_exception();
     }
   });
+  if (!planes.enabled) r.planes = PlaneMap();
   for (const std::exception_ptr& e : errors) {
     if (e) std::rethrow_exception(e);
   }
-  ReferenceGrids r;
-  r.coarse = std::move(grids[0]);
-  for (std::size_t k = 1; k < specs.size(); ++k) r.fine.push_back(std::move(grids[k]));
-  r.planes = std::move(plane_map);
-  return r;
 }
 
 GridWorkspace::GridWorkspace(const ReferenceGrids& grids) : coarse(grids.coarse) {

@@ -145,12 +145,20 @@ void CubeRegistration::setReference(const PointArray& reference) {
   planes.min_points = s.polish.min_points;
   planes.max_planarity = s.polish.max_planarity;
   planes.min_spread = s.polish.min_spread;
-  auto next = std::make_unique<ReferenceGrids>(
-      buildReferenceGrids(reference, s.grid, s.refine.enabled ? s.refine.grids : 0,
-                          s.refine.edge_fraction, s.search.threads, planes));
+  // The grids are rebuilt in the memory of the reference before the current one (the spare):
+  // no fresh pages to fault in at every scan.
+  std::unique_ptr<ReferenceGrids> next;
+  {
+    std::lock_guard<std::mutex> lock(*mutex_);
+    next = std::move(spare_);
+  }
+  if (!next) next = std::make_unique<ReferenceGrids>();
+  rebuildReferenceGrids(*next, reference, s.grid, s.refine.enabled ? s.refine.grids : 0,
+                        s.refine.edge_fraction, s.search.threads, planes);
   std::lock_guard<std::mutex> lock(*mutex_);
   // The working copies move to the new grids while the old ones are still alive.
   for (auto& w : workspaces_) w->retarget(*next);
+  spare_ = std::move(reference_);
   reference_ = std::move(next);
 }
 
@@ -201,7 +209,7 @@ void CubeRegistration::releaseScan() const {
 
 std::size_t CubeRegistration::referenceBytes() const {
   std::lock_guard<std::mutex> lock(*mutex_);
-  return reference_ ? reference_->memoryBytes() : 0;
+  return (reference_ ? reference_->memoryBytes() : 0) + (spare_ ? spare_->memoryBytes() : 0);
 }
 
 std::size_t CubeRegistration::workspaceBytes() const {

@@ -44,7 +44,16 @@ class KeyIndex {
   static constexpr std::uint32_t kNone = ~std::uint32_t{0};
 
   /// `expected`: a guess of the number of keys (the table grows past it).
-  explicit KeyIndex(std::size_t expected = 0) { rehash(expected); }
+  explicit KeyIndex(std::size_t expected = 0) { reset(expected); }
+  /// Empties the map, keeping its memory when it is large enough for `expected` keys.
+  void reset(std::size_t expected) {
+    std::size_t cap = 64;
+    while (cap < 2 * expected) cap <<= 1;
+    cap_ = std::max(cap, keys_.size());
+    keys_.assign(cap_, kEmpty);
+    index_.assign(cap_, kNone);
+    size_ = 0;
+  }
   /// The index of `key`, added as the next index if new; and whether it was new.
   std::pair<std::uint32_t, bool> insert(std::uint64_t key) {
     std::size_t h = mixKey(key) & (cap_ - 1);

@@ -62,6 +62,9 @@ class CubeGrid {
   /// Builds V and L from the reference points (which must be finite: filter them first).
   /// Throws CubeGridError (empty input, non-finite point, v above settings.max_cubes).
   static CubeGrid build(const PointArray& reference, const CubeGridSettings& settings);
+  /// The same in place, reusing this grid's memory (no page to fault in when the new grid is
+  /// no larger). On error the grid is left empty.
+  void rebuild(const PointArray& reference, const CubeGridSettings& settings);
 
   double edge() const { return edge_; }
   const Eigen::Vector3d& minCorner() const { return min_; }

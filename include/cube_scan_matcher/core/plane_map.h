@@ -41,6 +41,9 @@ class PlaneMap {
   /// 18 deg along a tunnel's axis 15 m ahead: information the tunnel does not have).
   PlaneMap(const PointArray& reference, double voxel, int min_points, double max_planarity,
            double min_spread = 0.0);
+  /// The same in place, reusing this map's memory. On error the map is left empty.
+  void rebuild(const PointArray& reference, double voxel, int min_points, double max_planarity,
+               double min_spread = 0.0);
   ~PlaneMap();
   PlaneMap(PlaneMap&&) noexcept;
   PlaneMap& operator=(PlaneMap&&) noexcept;
@@ -73,6 +76,7 @@ class PlaneMap {
   std::vector<Stats> stats_;
   mutable std::vector<Fit> fit_;
   mutable std::vector<LocalPlane> planes_;
+  std::vector<std::uint32_t> voxel_of_;  // scratch of rebuild(): each point's voxel index
 };
 
 }  // namespace cube_scan_matcher

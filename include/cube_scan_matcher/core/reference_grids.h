@@ -38,6 +38,13 @@ struct PlaneMapSettings {
 ReferenceGrids buildReferenceGrids(const PointArray& reference, const CubeGridSettings& grid,
                                    int fine_grids, double fine_edge_fraction, int threads,
                                    const PlaneMapSettings& planes = PlaneMapSettings{});
+/// The same into `grids`, reusing their memory (CubeGrid::rebuild, PlaneMap::rebuild): on a
+/// virtual machine every fresh page costs a fault of some 10 us, and a Velodyne reference's
+/// grids and plane map are ~2 MB. On error `grids` is left in a valid, unspecified state.
+void rebuildReferenceGrids(ReferenceGrids& grids, const PointArray& reference,
+                           const CubeGridSettings& grid, int fine_grids,
+                           double fine_edge_fraction, int threads,
+                           const PlaneMapSettings& planes = PlaneMapSettings{});
 
 /// One thread's objectives: a working copy of every grid of a ReferenceGrids. Moving it to
 /// other grids (retarget) reuses its memory instead of allocating it again.

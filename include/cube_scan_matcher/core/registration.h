@@ -156,8 +156,9 @@ class CubeRegistration {
   /// J of `scan` at `pose` on the coarse grid, with the same scan preparation as the result's
   /// J in align() (collapsing, all points). Needs a reference; returns 0 for an empty scan.
   int score(const PointArray& scan, const Pose6& pose) const;
-  /// Heap bytes of the reference's grids and plane map (0 without a reference), and of the
-  /// threads' working copies of them.
+  /// Heap bytes of the reference's grids and plane map (0 without a reference), including the
+  /// previous reference's, kept as the memory the next one is built in; and of the threads'
+  /// working copies of them.
   std::size_t referenceBytes() const;
   std::size_t workspaceBytes() const;
   /// polishSweepOnPlanes() on the reference's planes with the polish settings (issue 15).
@@ -195,6 +196,7 @@ class CubeRegistration {
 
   RegistrationSettings settings_;
   std::unique_ptr<ReferenceGrids> reference_;  // stable address: the workspaces point into it
+  std::unique_ptr<ReferenceGrids> spare_;      // the previous reference: memory to rebuild into
   mutable std::vector<std::unique_ptr<GridWorkspace>> workspaces_;  // one per thread
   mutable std::unique_ptr<std::mutex> mutex_;  // serialises align() and score()
 };
