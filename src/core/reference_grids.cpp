@@ -28,16 +28,18 @@ void rebuildReferenceGrids(ReferenceGrids& r, const PointArray& reference,
   }
   r.fine.resize(specs.size() - 1);
   auto grid_of = [&r](std::size_t k) -> CubeGrid& { return k == 0 ? r.coarse : r.fine[k - 1]; };
-  // The plane map is the last job, built beside the grids.
-  const int jobs = int(specs.size()) + (planes.enabled ? 1 : 0);
+  // The plane map, the longest job (as long as all grids on a corridor scan), goes first, so
+  // that the other thread builds the grids meanwhile.
+  const int first_grid = planes.enabled ? 1 : 0;
+  const int jobs = int(specs.size()) + first_grid;
   std::vector<std::exception_ptr> errors(static_cast<std::size_t>(jobs));
   runOnThreads(jobs, threads, [&](int k, int) {
     try {
-      if (k == int(specs.size())) {
+      if (k < first_grid) {
         r.planes.rebuild(reference, planes.voxel, planes.min_points, planes.max_planarity,
                          planes.min_spread);
       } else {
-        grid_of(std::size_t(k)).rebuild(reference, specs[std::size_t(k)]);
+        grid_of(std::size_t(k - first_grid)).rebuild(reference, specs[std::size_t(k - first_grid)]);
       }
     } catch (...) {
       errors[std::size_t(k)] = std::current_exception();

@@ -27,6 +27,42 @@ TEST(ReferenceGrids, AnErrorInAnyGridIsThrown) {
   EXPECT_THROW(buildReferenceGrids(ref, edge(0.5), 3, 0.5, 2), CubeGridError);
 }
 
+TEST(ReferenceGrids, RebuiltInTheMemoryOfOthersTheyEqualFreshOnes) {
+  const PointArray small = cornerScene(3000, 11), big = cornerScene(20000, 12);
+  PlaneMapSettings planes;
+  planes.enabled = true;
+  const ReferenceGrids fresh = buildReferenceGrids(small, edge(0.5), 3, 0.5, 2, planes);
+  // Into the grids of a larger scan, with other settings, and after an error.
+  ReferenceGrids reused = buildReferenceGrids(big, edge(0.4), 2, 0.5, 2, planes);
+  PointArray absurd = small;
+  absurd.push_back(1e6f, 1e6f, 1e6f);
+  EXPECT_THROW(rebuildReferenceGrids(reused, absurd, edge(0.5), 3, 0.5, 2, planes), CubeGridError);
+  rebuildReferenceGrids(reused, small, edge(0.5), 3, 0.5, 2, planes);
+  ASSERT_EQ(reused.fine.size(), 3u);
+  for (std::size_t k = 0; k < 4; ++k) {
+    const CubeGrid& a = k == 0 ? fresh.coarse : fresh.fine[k - 1];
+    const CubeGrid& b = k == 0 ? reused.coarse : reused.fine[k - 1];
+    EXPECT_EQ(a.dims(), b.dims()) << k;
+    EXPECT_EQ(a.minCorner(), b.minCorner()) << k;
+    EXPECT_EQ(a.bits(), b.bits()) << k;
+    EXPECT_EQ(a.list(), b.list()) << k;
+  }
+  ASSERT_EQ(fresh.planes.voxels(), reused.planes.voxels());
+  ASSERT_GT(fresh.planes.voxels(), 0u);
+  int planes_found = 0;
+  for (std::size_t i = 0; i < small.size(); i += 7) {
+    const Eigen::Vector3d q(small.x[i], small.y[i], small.z[i]);
+    const LocalPlane* a = fresh.planes.planeAt(q);
+    const LocalPlane* b = reused.planes.planeAt(q);
+    ASSERT_EQ(a == nullptr, b == nullptr) << i;
+    if (!a) continue;
+    ++planes_found;
+    EXPECT_EQ(a->mean, b->mean);
+    EXPECT_EQ(a->normal, b->normal);
+  }
+  EXPECT_GT(planes_found, 100);
+}
+
 TEST(GridWorkspace, ARetargetedWorkspaceGivesTheJOfAFreshOne) {
   const PointArray a = cornerScene(3000, 7), b = cornerScene(5000, 8);
   const ReferenceGrids ga = buildReferenceGrids(a, edge(0.5), 3, 0.5, 1);

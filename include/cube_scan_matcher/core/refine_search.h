@@ -56,7 +56,7 @@ struct RefineResult {
   int evaluations = 0;         ///< of all candidates.
 };
 
-/// Compass search from each candidate (at least one), candidate k on thread k % threads with
+/// Compass search from each candidate (at least one), on up to `threads` threads, each with
 /// objectives[thread]; the highest value wins (ties: the earlier candidate). Needs
 /// objectives.size() >= min(threads, candidates.size()).
 RefineResult refineCandidates(std::vector<MultiScaleObjective>& objectives,
