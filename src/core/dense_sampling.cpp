@@ -8,7 +8,6 @@
 
 namespace cube_scan_matcher {
 
-
 PointArray keepDenselySampled(const PointArray& points, double edge, int min_points,
                               DenseSamplingStats* stats) {
   if (!(edge > 0.0)) throw std::invalid_argument("dense sampling: cube edge must be > 0 m");
@@ -16,24 +15,21 @@ PointArray keepDenselySampled(const PointArray& points, double edge, int min_poi
   const float inv = float(1.0 / edge);
   detail::KeyIndex set(points.size() / 8);
   std::vector<std::uint32_t> count;  // points per cube, by the cube's index
-  std::vector<std::uint32_t> slot(points.size());
+  std::vector<std::uint32_t> cube_of(points.size());
   for (std::size_t i = 0; i < points.size(); ++i) {
     const auto [index, added] = set.insert(detail::voxelKey(points.x[i], points.y[i], points.z[i], inv));
     if (added) count.push_back(0);
-    slot[i] = index;
+    cube_of[i] = index;
     ++count[index];
   }
   PointArray out;
   out.reserve(points.size());
   for (std::size_t i = 0; i < points.size(); ++i) {
-    if (count[slot[i]] >= std::uint32_t(min_points)) out.push_back(points.x[i], points.y[i], points.z[i]);
+    if (count[cube_of[i]] >= std::uint32_t(min_points)) out.push_back(points.x[i], points.y[i], points.z[i]);
   }
-  std::size_t cubes = 0, dense_cubes = 0;
-  for (std::uint32_t c : count) {
-    cubes += c > 0;
-    dense_cubes += c >= std::uint32_t(min_points);
-  }
-  if (stats) *stats = {cubes, dense_cubes, out.size()};
+  std::size_t dense_cubes = 0;
+  for (std::uint32_t c : count) dense_cubes += c >= std::uint32_t(min_points);
+  if (stats) *stats = {count.size(), dense_cubes, out.size()};
   return out;
 }
 

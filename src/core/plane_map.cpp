@@ -25,7 +25,7 @@ PlaneMap::PlaneMap(const PointArray& reference, double voxel, int min_points,
 
 void PlaneMap::rebuild(const PointArray& reference, double voxel, int min_points,
                        double max_planarity, double min_spread) {
-  stats_.clear();  // empty (planeAt() finds nothing) until complete
+  stats_.clear();  // an error below leaves an empty map (planeAt() finds nothing)
   if (!(voxel > 0.0)) throw std::invalid_argument("plane map voxel must be > 0 m");
   voxel_ = voxel;
   inv_ = float(1.0 / voxel);
@@ -42,20 +42,17 @@ void PlaneMap::rebuild(const PointArray& reference, double voxel, int min_points
     if (!std::isfinite(x) || !std::isfinite(y) || !std::isfinite(z)) continue;
     voxel_of_[i] = keys_->insert(detail::voxelKey(x, y, z, inv_)).first;
   }
-  std::vector<Stats> stats;
-  stats.swap(stats_);
-  stats.assign(keys_->size(), Stats());
+  stats_.assign(keys_->size(), Stats());
   for (std::size_t i = 0; i < reference.size(); ++i) {
     if (voxel_of_[i] == detail::KeyIndex::kNone) continue;
-    Stats& s = stats[voxel_of_[i]];
+    Stats& s = stats_[voxel_of_[i]];
     const Eigen::Vector3d p(reference.x[i], reference.y[i], reference.z[i]);
     s.n += 1.0;
     s.sum += p;
     s.outer += p * p.transpose();
   }
-  fit_.assign(stats.size(), Fit::Unknown);
-  planes_.resize(stats.size());
-  stats_.swap(stats);
+  fit_.assign(stats_.size(), Fit::Unknown);
+  planes_.resize(stats_.size());
 }
 
 void PlaneMap::fit(std::size_t index, std::int64_t ix, std::int64_t iy, std::int64_t iz) const {

@@ -47,9 +47,7 @@ class KeyIndex {
   explicit KeyIndex(std::size_t expected = 0) { reset(expected); }
   /// Empties the map, keeping its memory when it is large enough for `expected` keys.
   void reset(std::size_t expected) {
-    std::size_t cap = 64;
-    while (cap < 2 * expected) cap <<= 1;
-    cap_ = std::max(cap, keys_.size());
+    cap_ = std::max(capacityFor(expected), keys_.size());
     keys_.assign(cap_, kEmpty);
     index_.assign(cap_, kNone);
     size_ = 0;
@@ -83,10 +81,15 @@ class KeyIndex {
 
  private:
   static constexpr std::uint64_t kEmpty = ~std::uint64_t{0};  // no packed key has bit 63 set
-  /// A table of at least 64 slots and at least 2 * n, with every key re-inserted.
-  void rehash(std::size_t n) {
+  /// The smallest power of two of at least 64 slots and at least 2 * n (half full at most).
+  static std::size_t capacityFor(std::size_t n) {
     std::size_t cap = 64;
     while (cap < 2 * n) cap <<= 1;
+    return cap;
+  }
+  /// A table of capacityFor(n) slots, with every key re-inserted.
+  void rehash(std::size_t n) {
+    const std::size_t cap = capacityFor(n);
     std::vector<std::uint64_t> keys(cap, kEmpty);
     std::vector<std::uint32_t> index(cap, kNone);
     for (std::size_t s = 0; s < keys_.size(); ++s) {
