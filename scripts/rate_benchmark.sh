@@ -5,7 +5,7 @@
 # prints the data age (stamp -> published pose), latency, registration time, drops and the
 # reference grids' memory; then the manager's peak resident memory. Needs a built package.
 # Exits non-zero if fewer than MIN_ANSWERED clouds were answered (CTest rate_benchmark_smoke).
-#   [CSM_SIMD=avx2] bash scripts/rate_benchmark.sh [RATE=20] [SECONDS=60] [MIN_ANSWERED=1]
+#   [CSM_SIMD=avx2] [CSM_CONFIG=my.yaml] bash scripts/rate_benchmark.sh [RATE=20] [SECONDS=60] [MIN_ANSWERED=1]
 set -eo pipefail
 RATE="${1:-20}"; SECONDS_="${2:-60}"; MIN_ANSWERED="${3:-1}"
 ROOT="$(cd "$(dirname "$0")/.." && pwd)"
@@ -15,11 +15,12 @@ source "$SETUP"
 WORK="$(mktemp -d)"
 PORT=$((12900 + RANDOM % 500))
 export ROS_MASTER_URI=http://localhost:$PORT
-roslaunch -p "$PORT" cube_scan_matcher scan_matcher.launch cloud:=cloud > "$WORK/launch.log" 2>&1 &
+CONFIG="${CSM_CONFIG:-$ROOT/config/scan_matcher.yaml}"
+roslaunch -p "$PORT" cube_scan_matcher scan_matcher.launch cloud:=cloud config:="$CONFIG" > "$WORK/launch.log" 2>&1 &
 LAUNCH=$!
 trap 'kill -INT $LAUNCH 2>/dev/null || true; wait $LAUNCH 2>/dev/null || true; rm -rf "$WORK"' EXIT
 for _ in $(seq 60); do rostopic list > /dev/null 2>&1 && break; sleep 0.5; done
-echo "$(grep -m1 'model name' /proc/cpuinfo | cut -d: -f2 | sed 's/^ //'); $(nproc) cores; CSM_SIMD=${CSM_SIMD:-auto}"
+echo "$(grep -m1 'model name' /proc/cpuinfo | cut -d: -f2 | sed 's/^ //'); $(nproc) cores; CSM_SIMD=${CSM_SIMD:-auto}; config $CONFIG"
 "$(dirname "$SETUP")/lib/cube_scan_matcher/rate_feeder" _rate:="$RATE" _duration:="$SECONDS_" _min_answered:="$MIN_ANSWERED"
 MANAGER=$(pgrep -f "__name:=scan_matcher_manager" | head -1 || true)
 if [ -n "$MANAGER" ]; then

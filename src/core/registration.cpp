@@ -67,6 +67,7 @@ void validate(const RegistrationSettings& s) {
   validate(s.polish);
   requireInRange("collapse_fraction", s.collapse_fraction, 0.0, 1.0);
   requireInRange("dense_points", s.dense_points, 0, 1000);
+  requireInRange("coarse_max_points", s.coarse_max_points, 0, 10000000);
 }
 
 std::string toString(RegistrationStatus status) {
@@ -90,7 +91,8 @@ struct CubeRegistration::ScanPoints {
   const PointArray* full = nullptr;    ///< all points collapsed as for the coarse search: J
   const PointArray* fine = nullptr;    ///< the refine's points (all points, collapsed)
   const PointArray* polish = nullptr;  ///< the polish's points (all points, collapsed)
-  PointArray dense_storage, coarse_storage, full_storage, fine_storage, polish_storage;
+  PointArray dense_storage, coarse_storage, full_storage, fine_storage, polish_storage,
+      thinned_storage;
 };
 
 CubeRegistration::CubeRegistration(const RegistrationSettings& settings)
@@ -196,6 +198,17 @@ void CubeRegistration::prepareScan(const PointArray& scan, ScanPoints& p) const 
                                          : collapsed(from(dense, cf), cf, edge, p.coarse_storage);
   p.full = &dense == &scan ? p.coarse
                            : collapsed(from(scan, cf), cf, edge, p.full_storage);
+  const std::size_t cap = std::size_t(settings_.coarse_max_points);
+  if (cap > 0 && p.coarse->size() > cap) {
+    // Evenly spaced in scan order: the sweep's lines keep their spread.
+    const PointArray& all = *p.coarse;
+    p.thinned_storage.reserve(cap);
+    for (std::size_t i = 0; i < cap; ++i) {
+      const std::size_t k = i * all.size() / cap;
+      p.thinned_storage.push_back(all.x[k], all.y[k], all.z[k]);
+    }
+    p.coarse = &p.thinned_storage;
+  }
   if (!settings_.polish.enabled) return;
   const double pf = settings_.polish.collapse_fraction;
   p.polish = pf == rf   ? p.fine

@@ -44,6 +44,7 @@ void configToSettings(const ScanMatcherConfig& c, OnlineMatcherSettings& m) {
   r.search.threads = c.threads;
   r.collapse_fraction = c.collapse_fraction;
   r.dense_points = c.dense_points;
+  r.coarse_max_points = c.coarse_max_points;
   r.refine.enabled = c.refine;
   r.refine.edge_fraction = c.refine_edge_fraction;
   r.refine.grids = c.refine_grids;
@@ -131,6 +132,7 @@ ScanMatcherConfig toConfig(const NodeParams& p) {
   c.threads = r.search.threads;
   c.collapse_fraction = r.collapse_fraction;
   c.dense_points = r.dense_points;
+  c.coarse_max_points = r.coarse_max_points;
   c.refine = r.refine.enabled;
   c.refine_edge_fraction = r.refine.edge_fraction;
   c.refine_grids = r.refine.grids;

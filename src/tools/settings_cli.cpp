@@ -68,6 +68,8 @@ std::string algorithmOptionsHelp() {
          "                        the strongest information (default " + num(d.polish.weak_ratio) + ")\n"
          "  --polish-iterations N Gauss-Newton steps of the polish (default " + std::to_string(d.polish.max_iterations) + ")\n"
          "  --covariance-scale C  the polish's covariance is C x sigma^2 H^-1 (default " + num(d.polish.covariance_scale) + ")\n"
+         "  --coarse-max-points N the coarse search evaluates at most N collapsed points, 0 = all\n"
+         "                        (default " + num(d.coarse_max_points) + ")\n"
          "  --refine-collapse F   the refine stage evaluates one point per voxel of F*E\n"
          "                        (default " + num(d.refine.collapse_fraction) + ")\n"
          "  --refine-grids K      refine on the sum of J over K fine grids shifted by 1/K cube\n"
@@ -152,6 +154,8 @@ bool parseAlgorithmOption(const std::vector<std::string>& args, std::size_t& i,
     s.refine.coarse_weight = value(1), used = 2;
   } else if (a == "--refine-candidates") {
     s.refine.candidates = int(value(1)), used = 2;
+  } else if (a == "--coarse-max-points") {
+    s.coarse_max_points = int(value(1)), used = 2;
   } else if (a == "--refine-collapse") {
     s.refine.collapse_fraction = value(1), used = 2;
   } else if (a == "--refine-grids") {

@@ -323,6 +323,33 @@ TEST(Registration, SettingsAreValidated) {
   s = RegistrationSettings{};
   s.search.axis_probe_gain = 2.0;
   EXPECT_THROW(CubeRegistration{s}, std::invalid_argument);
+  s = RegistrationSettings{};
+  s.coarse_max_points = -1;
+  EXPECT_THROW(CubeRegistration{s}, std::invalid_argument);
+}
+
+// coarse_max_points: the coarse search evaluates no more points than the cap, J at the result
+// still counts them all (as without the cap), and the known transform is recovered.
+TEST(Registration, ACapOnTheCoarsePointsKeepsTheResult) {
+  const Scans s = makeScans(sim::SceneType::Urban, 1);
+  RegistrationSettings settings;
+  CubeRegistration full(settings);
+  full.setReference(s.first);
+  const Pose6 truth = isometryToPose(s.T_first_second);
+  Pose6 guess = truth;
+  guess.head<3>() += Eigen::Vector3d(0.6, -0.5, 0.1);
+  guess[5] += deg2rad(5.0);
+  const RegistrationResult all = full.align(s.second, guess);
+  ASSERT_GT(all.points_used, 3000u);
+  settings.coarse_max_points = int(all.points_used / 3);
+  CubeRegistration capped(settings);
+  capped.setReference(s.first);
+  const RegistrationResult r = capped.align(s.second, guess);
+  EXPECT_EQ(r.points_used, std::size_t(settings.coarse_max_points));
+  ASSERT_TRUE(r.ok());
+  EXPECT_EQ(r.J, capped.score(s.second, r.pose));  // J on all points, not the cap's
+  EXPECT_LT((r.transform.translation() - s.T_first_second.translation()).norm(), 0.02);
+  EXPECT_LT(rad2deg(Eigen::AngleAxisd(r.transform.linear().transpose() * s.T_first_second.linear()).angle()), 0.1);
 }
 
 }  // namespace

@@ -53,6 +53,10 @@ struct RegistrationSettings {
   /// to 0.2-0.6 %, but costs accuracy in some pairwise cases (BENCHMARK.md, "The no-motion
   /// maximum"); issue 12 decides the default.
   int dense_points = 0;
+  /// Beyond the paper: the coarse search evaluates at most this many of the collapsed points,
+  /// evenly spaced in scan order (J at the result and the gate's J use them all). 0 = all.
+  /// In [0, 1e7].
+  int coarse_max_points = 0;
 
   /// The paper's fixed mode: one GNMM of 15 vertices and 500 iterations on all points,
   /// restarts around the initial estimate within +-1 m / +-8 deg, no refine stage.
