@@ -2,6 +2,8 @@
 
 #include <algorithm>
 
+#include "reuse_memory.h"
+
 namespace cube_scan_matcher {
 
 CoincidenceObjective::CoincidenceObjective(const CubeGrid& grid) : grid_(&grid), idx_(kBlock) {
@@ -16,12 +18,14 @@ void CoincidenceObjective::initWorkingCopy() {
   if (grid.bytePerCube()) {
     std::vector<std::uint64_t>().swap(bits_);
     outside_ = std::int32_t(grid.cubeCount());
+    reserveForRebuild(bytes_, std::size_t(grid.cubeCount()) + 1);  // all zero, or dropped
     bytes_.resize(std::size_t(grid.cubeCount()) + 1, 0);
     for (std::int32_t c : grid.list()) bytes_[std::size_t(c)] = 1;
   } else {
     std::vector<std::uint8_t>().swap(bytes_);
     const std::size_t words = grid.bits().size();
     outside_ = std::int32_t(words * 64);
+    reserveForRebuild(bits_, words + 1);
     bits_.resize(words + 1, 0);
     for (std::int32_t c : grid.list()) bits_[std::size_t(c) >> 6] |= std::uint64_t{1} << (c & 63);
   }

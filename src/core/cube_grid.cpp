@@ -9,6 +9,7 @@
 #include <sstream>
 
 #include "cube_scan_matcher/core/simd_path.h"
+#include "reuse_memory.h"
 
 namespace cube_scan_matcher {
 
@@ -268,6 +269,7 @@ void CubeGrid::rebuild(const PointArray& ref, const CubeGridSettings& settings) 
   max_ = hi;
   dims_ = dims;
   dims_f_ = dims_.cast<float>();
+  reserveForRebuild(bits_, (cubeCount() + 63) / 64);
   bits_.assign((cubeCount() + 63) / 64, 0);
   // Indices a block at a time (no index array the size of the scan to allocate).
   constexpr std::size_t kBlock = 1024;

@@ -8,6 +8,7 @@
 
 #include "cube_scan_matcher/core/deskew.h"
 #include "require_in_range.h"
+#include "reuse_memory.h"
 
 namespace cube_scan_matcher {
 
@@ -57,27 +58,45 @@ void OnlineMatcher::restartAt(const Eigen::Isometry3d& pose) {
   start_pose_ = pose;
 }
 
-PointArray OnlineMatcher::submapPoints(const std::deque<Keyframe>& keyframes, int submap_size) {
+void OnlineMatcher::submapPoints(const std::deque<Keyframe>& keyframes, int submap_size,
+                                 PointArray& out) {
   const std::size_t n = std::min(keyframes.size(), std::size_t(submap_size));
-  if (n == 1) return keyframes.back().points;
-  PointArray merged;
+  std::size_t total = 0;
+  for (std::size_t i = keyframes.size() - n; i < keyframes.size(); ++i) {
+    total += keyframes[i].points.size();
+  }
+  clearForRebuild(out, total);
+  if (n == 1) {
+    const PointArray& only = keyframes.back().points;
+    out.x = only.x, out.y = only.y, out.z = only.z;  // within the reserved capacity
+    return;
+  }
   const Eigen::Isometry3d to_newest = keyframes.back().pose.inverse();
   for (std::size_t i = keyframes.size() - n; i < keyframes.size(); ++i) {
-    appendTransformed(merged, keyframes[i].points, to_newest * keyframes[i].pose);
+    appendTransformed(out, keyframes[i].points, to_newest * keyframes[i].pose);
   }
-  return merged;
 }
 
-bool OnlineMatcher::addKeyframe(Keyframe keyframe, std::string& why) {
-  keyframes_.push_back(std::move(keyframe));
+bool OnlineMatcher::addKeyframe(const PointArray& points, const Eigen::Isometry3d& pose,
+                                double stamp, std::string& why) {
+  // The keyframe's copy of the points goes into the memory of the last keyframe to leave.
+  PointArray copy = std::move(recycled_);
+  clearForRebuild(copy, points.size());
+  copy.x = points.x, copy.y = points.y, copy.z = points.z;
+  keyframes_.push_back(Keyframe{std::move(copy), pose, stamp});
   try {
-    registration_.setReference(submapPoints(keyframes_, settings_.keyframes.submap_size));
+    submapPoints(keyframes_, settings_.keyframes.submap_size, submap_);
+    registration_.setReference(submap_);
   } catch (const std::exception& e) {
+    recycled_ = std::move(keyframes_.back().points);
     keyframes_.pop_back();
     why = e.what();
     return false;
   }
-  while (keyframes_.size() > std::size_t(settings_.keyframes.submap_size)) keyframes_.pop_front();
+  while (keyframes_.size() > std::size_t(settings_.keyframes.submap_size)) {
+    recycled_ = std::move(keyframes_.front().points);
+    keyframes_.pop_front();
+  }
   return true;
 }
 
@@ -88,7 +107,9 @@ void OnlineMatcher::setSettings(const OnlineMatcherSettings& settings) {
     // built (the memory cap) throw here and leave the matcher as it was.
     CubeRegistration rebuilt(settings.registration);
     try {
-      rebuilt.setReference(submapPoints(keyframes_, settings.keyframes.submap_size));
+      PointArray submap;
+      submapPoints(keyframes_, settings.keyframes.submap_size, submap);
+      rebuilt.setReference(submap);
     } catch (const std::exception& e) {
       throw std::invalid_argument(std::string("the current reference cannot be built with these "
                                               "settings: ") + e.what());
@@ -268,7 +289,7 @@ OnlineStep OnlineMatcher::process(const PointArray& scan_points, double stamp,
                      (k.interval > 0.0 && stamp - keyframe->stamp >= k.interval);
     }
     std::string why;
-    if (new_keyframe && !addKeyframe(Keyframe{points, step.pose, stamp}, why)) {
+    if (new_keyframe && !addKeyframe(points, step.pose, stamp, why)) {
       if (first) step.reason = GateReason::BadReference;
       if (!step.message.empty()) step.message += "; ";
       step.message += "scan not used as reference: " + why;

@@ -5,6 +5,7 @@
 
 #include <Eigen/Eigenvalues>
 
+#include "reuse_memory.h"
 #include "voxel_key.h"
 
 namespace cube_scan_matcher {
@@ -36,12 +37,14 @@ void PlaneMap::rebuild(const PointArray& reference, double voxel, int min_points
   keys_->reset(reference.size() / 8);
   // Two passes: the voxel of every point, then the sums in one allocation (growing a vector of
   // 104-byte sums would copy it over and over).
+  reserveForRebuild(voxel_of_, reference.size());
   voxel_of_.assign(reference.size(), detail::KeyIndex::kNone);
   for (std::size_t i = 0; i < reference.size(); ++i) {
     const float x = reference.x[i], y = reference.y[i], z = reference.z[i];
     if (!std::isfinite(x) || !std::isfinite(y) || !std::isfinite(z)) continue;
     voxel_of_[i] = keys_->insert(detail::voxelKey(x, y, z, inv_)).first;
   }
+  reserveForRebuild(stats_, keys_->size());
   stats_.assign(keys_->size(), Stats());
   for (std::size_t i = 0; i < reference.size(); ++i) {
     if (voxel_of_[i] == detail::KeyIndex::kNone) continue;
@@ -51,7 +54,9 @@ void PlaneMap::rebuild(const PointArray& reference, double voxel, int min_points
     s.sum += p;
     s.outer += p * p.transpose();
   }
+  reserveForRebuild(fit_, stats_.size());
   fit_.assign(stats_.size(), Fit::Unknown);
+  reserveForRebuild(planes_, stats_.size());
   planes_.resize(stats_.size());
 }
 

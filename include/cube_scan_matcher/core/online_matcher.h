@@ -157,11 +157,13 @@ class OnlineMatcher {
     Eigen::Isometry3d pose;   // T_map_base
     double stamp;             // [s]
   };
-  /// The reference's points: the last submap_size keyframes in the frame of the newest.
-  static PointArray submapPoints(const std::deque<Keyframe>& keyframes, int submap_size);
+  /// The reference's points: the last submap_size keyframes in the frame of the newest, into
+  /// `out` (its memory reused).
+  static void submapPoints(const std::deque<Keyframe>& keyframes, int submap_size, PointArray& out);
   /// Adds a keyframe and rebuilds the reference; false (state unchanged) if its grid cannot
   /// be built, with the reason in `why`.
-  bool addKeyframe(Keyframe keyframe, std::string& why);
+  bool addKeyframe(const PointArray& points, const Eigen::Isometry3d& pose, double stamp,
+                   std::string& why);
   double gateScale(double stamp, double since) const;
   /// De-skews an accepted scan with the registered motion over `interval` [s] since
   /// last_known_ into `out`, and registers it once more if the settings say so (keeping the
@@ -172,6 +174,9 @@ class OnlineMatcher {
   OnlineMatcherSettings settings_;
   CubeRegistration registration_;
   std::deque<Keyframe> keyframes_;  // oldest first; back() is the reference's frame
+  // Memory kept between keyframes (no fresh pages to fault in at each one): the merged submap,
+  // and the points of the last keyframe to leave the submap, for the next one's copy.
+  PointArray submap_, recycled_;
   std::optional<Eigen::Isometry3d> start_pose_;  // of the next first scan (restartAt)
   /// A scan whose pose is known: T_map_base, T_odom_base there (if it had odometry), stamp.
   struct Known {

@@ -1,0 +1,32 @@
+// Private to the core: buffers that are rebuilt for every new reference (grids, plane map,
+// working copies, the keyframe submap) keep their memory. A buffer that must grow is allocated
+// with a quarter of headroom, so that the next, slightly larger rebuild reuses it: fresh pages
+// cost a fault each when first written (about 10 us on a VM), which made up most of a
+// keyframe's rebuild in the rate benchmark (BENCHMARK.md, "Page faults at keyframes").
+#pragma once
+
+#include <cstddef>
+#include <vector>
+
+#include "cube_scan_matcher/core/point_array.h"
+
+namespace cube_scan_matcher {
+
+/// Makes room for n elements; the contents are dropped when the memory is not large enough
+/// (callers assign or resize next).
+template <typename T>
+void reserveForRebuild(std::vector<T>& v, std::size_t n) {
+  if (v.capacity() >= n) return;
+  v.clear();
+  v.reserve(n + n / 4);
+}
+
+/// The same for the three arrays of a PointArray, which is emptied.
+inline void clearForRebuild(PointArray& p, std::size_t n) {
+  p.clear();
+  reserveForRebuild(p.x, n);
+  reserveForRebuild(p.y, n);
+  reserveForRebuild(p.z, n);
+}
+
+}  // namespace cube_scan_matcher
