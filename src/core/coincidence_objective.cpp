@@ -69,13 +69,6 @@ bool CoincidenceObjective::workingCopyRestored() const {
          bits_.back() == 0;
 }
 
-int CoincidenceObjective::evaluate(const Pose6& pose) {
-  if (!scan_ || scan_->empty()) return 0;
-  const Eigen::Isometry3d t = poseToIsometry(pose);
-  const GridAffine g = grid_->affine(t.linear().cast<float>(), t.translation().cast<float>());
-  return bytePerCube() ? countBytes(g) : countBits(g);
-}
-
 template <typename CountBlock>
 void CoincidenceObjective::forEachIndexBlock(const GridAffine& g, CountBlock&& count_block) {
   const Eigen::Vector3f& dims = grid_->dimsF();
@@ -88,28 +81,45 @@ void CoincidenceObjective::forEachIndexBlock(const GridAffine& g, CountBlock&& c
   }
 }
 
-int CoincidenceObjective::countBytes(const GridAffine& g) {
+int CoincidenceObjective::evaluate(const Pose6& pose) {
+  if (!scan_ || scan_->empty()) return 0;
+  const Eigen::Isometry3d t = poseToIsometry(pose);
+  const GridAffine g = grid_->affine(t.linear().cast<float>(), t.translation().cast<float>());
+  startCount();
+  if (bytePerCube()) {
+    forEachIndexBlock(g, [this](const std::int32_t* id, std::size_t m) { countBytes(id, m); });
+  } else {
+    forEachIndexBlock(g, [this](const std::int32_t* id, std::size_t m) { countBits(id, m); });
+  }
+  return finishCount();
+}
+
+void CoincidenceObjective::countBlock(const std::int32_t* idx, std::size_t m) {
+  if (bytePerCube()) {
+    countBytes(idx, m);
+  } else {
+    countBits(idx, m);
+  }
+}
+
+void CoincidenceObjective::countBytes(const std::int32_t* id, std::size_t m) {
   std::uint8_t* const v = bytes_.data();
-  int j = 0;
+  int j = j_;
   // A set cube hit for the first time counts 1 and is cleared; a clear cube, a cube already
   // hit and the spare outside cube count 0. The store does not depend on the load, so
   // consecutive points in the same cube do not wait on each other.
-  forEachIndexBlock(g, [v, &j](const std::int32_t* id, std::size_t m) {
-    for (std::size_t i = 0; i < m; ++i) {
-      std::uint8_t& cube = v[std::uint32_t(id[i])];
-      j += cube;
-      cube = 0;
-    }
-  });
-  // Restore from L (the paper's way, l stores): cheaper than recording the J hits in the loop.
-  for (std::int32_t c : grid_->list()) v[std::size_t(c)] = 1;
-  return j;
+  for (std::size_t i = 0; i < m; ++i) {
+    std::uint8_t& cube = v[std::uint32_t(id[i])];
+    j += cube;
+    cube = 0;
+  }
+  j_ = j;
 }
 
-int CoincidenceObjective::countBits(const GridAffine& g) {
+void CoincidenceObjective::countBits(const std::int32_t* id, std::size_t m) {
   std::uint64_t* const v = bits_.data();
   std::int32_t* const hits = hits_.data();
-  int j = 0;
+  int j = j_;
   // Branch-free: a set cube hit for the first time is counted and cleared; a clear cube,
   // a cube already hit, and the spare outside cube change nothing. Consecutive scan points
   // mostly hit the same word of V, so one stream would wait on its own store at every point;
@@ -121,21 +131,30 @@ int CoincidenceObjective::countBits(const GridAffine& g) {
     hits[j] = std::int32_t(c);
     j += int(hit);
   };
-  forEachIndexBlock(g, [&count](const std::int32_t* id, std::size_t m) {
-    const std::size_t q = m / 4;
-    for (std::size_t i = 0; i < q; ++i) {
-      count(std::uint32_t(id[i]));
-      count(std::uint32_t(id[i + q]));
-      count(std::uint32_t(id[i + 2 * q]));
-      count(std::uint32_t(id[i + 3 * q]));
-    }
-    for (std::size_t i = 4 * q; i < m; ++i) count(std::uint32_t(id[i]));
-  });
-  // Restore V from the hits (J <= l steps; the paper restores from L, l steps).
-  for (int k = 0; k < j; ++k) {
-    v[std::size_t(hits[k]) >> 6] |= std::uint64_t{1} << (hits[k] & 63);
+  const std::size_t q = m / 4;
+  for (std::size_t i = 0; i < q; ++i) {
+    count(std::uint32_t(id[i]));
+    count(std::uint32_t(id[i + q]));
+    count(std::uint32_t(id[i + 2 * q]));
+    count(std::uint32_t(id[i + 3 * q]));
   }
-  return j;
+  for (std::size_t i = 4 * q; i < m; ++i) count(std::uint32_t(id[i]));
+  j_ = j;
+}
+
+int CoincidenceObjective::finishCount() {
+  if (bytePerCube()) {
+    // Restore from L (the paper's way, l stores): cheaper than recording the J hits in the loop.
+    std::uint8_t* const v = bytes_.data();
+    for (std::int32_t c : grid_->list()) v[std::size_t(c)] = 1;
+  } else {
+    // Restore V from the hits (J <= l steps; the paper restores from L, l steps).
+    std::uint64_t* const v = bits_.data();
+    for (int k = 0; k < j_; ++k) {
+      v[std::size_t(hits_[std::size_t(k)]) >> 6] |= std::uint64_t{1} << (hits_[std::size_t(k)] & 63);
+    }
+  }
+  return j_;
 }
 
 }  // namespace cube_scan_matcher

@@ -86,9 +86,68 @@ inline __attribute__((always_inline)) void cubeIndicesBody(
   }
 }
 
+// The same in two steps, for grids that share a rotation: u = A p once per block (the sums
+// in the order of cubeIndicesBody, without b), then per grid a = s u + b. For s a power of two
+// s u rounds like (s A) p term by term, so the indices are those of cubeIndicesBody with
+// a = s A (barring subnormal products).
+inline __attribute__((always_inline)) void rotateBody(const float (&a)[3][3], const float* x,
+                                                      const float* y, const float* z,
+                                                      std::size_t n, float* ux, float* uy,
+                                                      float* uz) {
+  const float a00 = a[0][0], a01 = a[0][1], a02 = a[0][2];
+  const float a10 = a[1][0], a11 = a[1][1], a12 = a[1][2];
+  const float a20 = a[2][0], a21 = a[2][1], a22 = a[2][2];
+#pragma omp simd
+  for (std::size_t i = 0; i < n; ++i) {
+    const float px = x[i], py = y[i], pz = z[i];
+    ux[i] = a00 * px + a01 * py + a02 * pz;
+    uy[i] = a10 * px + a11 * py + a12 * pz;
+    uz[i] = a20 * px + a21 * py + a22 * pz;
+  }
+}
+
+inline __attribute__((always_inline)) void indicesFromRotatedBody(
+    float s, const float (&b)[3], const Eigen::Vector3f& dims, const float* ux, const float* uy,
+    const float* uz, std::size_t n, std::int32_t outside, std::int32_t* idx) {
+  const float nx = dims.x(), ny = dims.y(), nz = dims.z();
+  const std::uint32_t sx = std::uint32_t(nx), sxy = sx * std::uint32_t(ny);
+  const float b0 = b[0], b1 = b[1], b2 = b[2];
+#pragma omp simd
+  for (std::size_t i = 0; i < n; ++i) {
+    const float ax = s * ux[i] + b0, ay = s * uy[i] + b1, az = s * uz[i] + b2;
+    // As in cubeIndicesBody: the in-grid test, then a clamp that defines the conversion.
+    const bool inside = (ax >= 0.f) & (ax < nx) & (ay >= 0.f) & (ay < ny) & (az >= 0.f) & (az < nz);
+    const std::uint32_t ix = std::uint32_t(std::int32_t(std::min(std::max(0.f, ax), nx)));
+    const std::uint32_t iy = std::uint32_t(std::int32_t(std::min(std::max(0.f, ay), ny)));
+    const std::uint32_t iz = std::uint32_t(std::int32_t(std::min(std::max(0.f, az), nz)));
+    idx[i] = inside ? std::int32_t(ix + iy * sx + iz * sxy) : outside;
+  }
+}
+
 using IndexKernel = void (*)(const GridAffine&, const Eigen::Vector3f&, const float*,
                              const float*, const float*, std::size_t, std::int32_t,
                              std::int32_t*);
+using RotateKernel = void (*)(const float (&)[3][3], const float*, const float*, const float*,
+                              std::size_t, float*, float*, float*);
+using RotatedIndexKernel = void (*)(float, const float (&)[3], const Eigen::Vector3f&,
+                                    const float*, const float*, const float*, std::size_t,
+                                    std::int32_t, std::int32_t*);
+
+/// One function per instruction set for each body (see above).
+#define CSM_SIMD_CLONES(target_attr, suffix)                                                   \
+  target_attr void rotate##suffix(const float (&a)[3][3], const float* x, const float* y,      \
+                                  const float* z, std::size_t n, float* ux, float* uy,         \
+                                  float* uz) {                                                 \
+    rotateBody(a, x, y, z, n, ux, uy, uz);                                                     \
+  }                                                                                            \
+  target_attr void indicesFromRotated##suffix(                                                 \
+      float s, const float (&b)[3], const Eigen::Vector3f& dims, const float* ux,              \
+      const float* uy, const float* uz, std::size_t n, std::int32_t outside,                   \
+      std::int32_t* idx) {                                                                     \
+    indicesFromRotatedBody(s, b, dims, ux, uy, uz, n, outside, idx);                           \
+  }
+
+CSM_SIMD_CLONES(, Portable)
 
 void cubeIndicesPortable(const GridAffine& g, const Eigen::Vector3f& dims, const float* x,
                          const float* y, const float* z, std::size_t n, std::int32_t outside,
@@ -108,7 +167,10 @@ __attribute__((target("avx512f"))) void cubeIndicesAvx512(
     const float* z, std::size_t n, std::int32_t outside, std::int32_t* idx) {
   cubeIndicesBody(g, dims, x, y, z, n, outside, idx);
 }
+CSM_SIMD_CLONES(__attribute__((target("avx2"))), Avx2)
+CSM_SIMD_CLONES(__attribute__((target("avx512f"))), Avx512)
 #endif
+#undef CSM_SIMD_CLONES
 
 IndexKernel kernelFor(SimdPath path) {
 #ifdef CSM_HAVE_X86_PATHS
@@ -117,6 +179,24 @@ IndexKernel kernelFor(SimdPath path) {
 #endif
   (void)path;
   return cubeIndicesPortable;
+}
+
+RotateKernel rotateKernelFor(SimdPath path) {
+#ifdef CSM_HAVE_X86_PATHS
+  if (path == SimdPath::Avx512) return rotateAvx512;
+  if (path == SimdPath::Avx2) return rotateAvx2;
+#endif
+  (void)path;
+  return rotatePortable;
+}
+
+RotatedIndexKernel rotatedIndexKernelFor(SimdPath path) {
+#ifdef CSM_HAVE_X86_PATHS
+  if (path == SimdPath::Avx512) return indicesFromRotatedAvx512;
+  if (path == SimdPath::Avx2) return indicesFromRotatedAvx2;
+#endif
+  (void)path;
+  return indicesFromRotatedPortable;
 }
 
 /// Every path, fastest first.
@@ -207,6 +287,17 @@ void computeCubeIndices(const GridAffine& g, const Eigen::Vector3f& dims, const 
                         const float* y, const float* z, std::size_t n, std::int32_t outside,
                         std::int32_t* idx) {
   kernelFor(activeSimdPath())(g, dims, x, y, z, n, outside, idx);
+}
+
+void rotatePoints(const float (&a)[3][3], const float* x, const float* y, const float* z,
+                  std::size_t n, float* ux, float* uy, float* uz) {
+  rotateKernelFor(activeSimdPath())(a, x, y, z, n, ux, uy, uz);
+}
+
+void cubeIndicesFromRotated(float s, const float (&b)[3], const Eigen::Vector3f& dims,
+                            const float* ux, const float* uy, const float* uz, std::size_t n,
+                            std::int32_t outside, std::int32_t* idx) {
+  rotatedIndexKernelFor(activeSimdPath())(s, b, dims, ux, uy, uz, n, outside, idx);
 }
 
 CubeGrid CubeGrid::build(const PointArray& ref, const CubeGridSettings& settings) {

@@ -1,5 +1,7 @@
 #include "cube_scan_matcher/core/multi_scale_objective.h"
 
+#include <algorithm>
+#include <cmath>
 #include <utility>
 
 namespace cube_scan_matcher {
@@ -12,9 +14,59 @@ MultiScaleObjective::MultiScaleObjective(std::vector<CoincidenceObjective*> fine
 double MultiScaleObjective::operator()(const Vector6d& q) {
   const Pose6 p = pose(q);
   int fine_sum = 0, coarse_j = 0;
-  for (CoincidenceObjective* j : fine_) fine_sum += (*j)(p);
-  if (coarse_weight_ > 0.0) coarse_j = (*coarse_)(p);
+  together_last_ = evaluateTogether(p, fine_sum, coarse_j);
+  if (!together_last_) {
+    for (CoincidenceObjective* j : fine_) fine_sum += (*j)(p);
+    if (coarse_weight_ > 0.0) coarse_j = (*coarse_)(p);
+  }
   return double(fine_sum) + coarse_weight_ * double(coarse_j);
+}
+
+bool MultiScaleObjective::evaluateTogether(const Pose6& p, int& fine_sum, int& coarse_j) {
+  // The grids' affines at p: their rotation parts must be power-of-two multiples of the first
+  // one's, entry for entry (edges E / 2^k), and the objectives must share one scan.
+  std::vector<CoincidenceObjective*>& all = together_;
+  all.assign(fine_.begin(), fine_.end());
+  if (coarse_weight_ > 0.0) all.push_back(coarse_);
+  if (all.size() < 2) return false;
+  const PointArray* scan = all.front()->scan();
+  if (!scan || scan->empty()) return false;
+  const Eigen::Isometry3d t = poseToIsometry(p);
+  const Eigen::Matrix3f r = t.linear().cast<float>();
+  const Eigen::Vector3f tr = t.translation().cast<float>();
+  affines_.resize(all.size());
+  scales_.resize(all.size());
+  for (std::size_t k = 0; k < all.size(); ++k) {
+    if (all[k]->scan() != scan) return false;
+    affines_[k] = all[k]->grid().affine(r, tr);
+    const float s = float(1.0 / all[k]->grid().edge()) / float(1.0 / all.front()->grid().edge());
+    int e = 0;
+    if (!(std::frexp(s, &e) == 0.5f)) return false;  // not a power of two
+    for (int i = 0; i < 3; ++i) {
+      for (int j = 0; j < 3; ++j) {
+        if (!(affines_[k].a[i][j] == s * affines_[0].a[i][j])) return false;
+      }
+    }
+    scales_[k] = s;
+  }
+  // One rotation per block, then the indices and the count on each grid.
+  constexpr std::size_t kBlock = CoincidenceObjective::kBlock;
+  ux_.resize(kBlock), uy_.resize(kBlock), uz_.resize(kBlock), idx_.resize(kBlock);
+  for (CoincidenceObjective* o : all) o->startCount();
+  for (std::size_t begin = 0; begin < scan->size(); begin += kBlock) {
+    const std::size_t m = std::min(kBlock, scan->size() - begin);
+    rotatePoints(affines_[0].a, scan->x.data() + begin, scan->y.data() + begin,
+                 scan->z.data() + begin, m, ux_.data(), uy_.data(), uz_.data());
+    for (std::size_t k = 0; k < all.size(); ++k) {
+      cubeIndicesFromRotated(scales_[k], affines_[k].b, all[k]->grid().dimsF(), ux_.data(),
+                             uy_.data(), uz_.data(), m, all[k]->outsideIndex(), idx_.data());
+      all[k]->countBlock(idx_.data(), m);
+    }
+  }
+  fine_sum = 0;
+  for (CoincidenceObjective* o : fine_) fine_sum += o->finishCount();
+  coarse_j = coarse_weight_ > 0.0 ? coarse_->finishCount() : 0;
+  return true;
 }
 
 Pose6 MultiScaleObjective::pose(const Vector6d& q) const {

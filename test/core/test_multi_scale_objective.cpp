@@ -1,9 +1,11 @@
 // The refine objective: the sum of fine J plus w x J on the E grid, over a pivoted variable.
 #include <gtest/gtest.h>
 
+#include <random>
 #include <vector>
 
 #include "cube_scan_matcher/core/multi_scale_objective.h"
+#include "cube_scan_matcher/core/simd_path.h"
 #include "grid_test_helpers.h"
 
 using namespace cube_scan_matcher;
@@ -33,6 +35,49 @@ TEST(MultiScaleObjective, IsTheSumOfFineJPlusTheWeightedCoarseJ) {
   // With w = 0 the E grid is not evaluated at all.
   MultiScaleObjective fine_only({&f0, &f1}, nullptr, 0.0, pivot);
   EXPECT_DOUBLE_EQ(fine_only(q), double(f0(p) + f1(p)));
+}
+
+// All grids in one pass (one rotation per block of points, the grids' edges E/2 and E) give
+// exactly the J of each grid evaluated on its own, on every vector path, with a working copy
+// of a byte or a bit per cube; grids whose edges are not E/2^k are evaluated one by one.
+TEST(MultiScaleObjective, GridsEvaluatedTogetherGiveEachGridsJ) {
+  const PointArray ref = cornerScene(6000, 5);
+  const PointArray scan = transformed(cornerScene(5000, 6), poseToIsometry(shift(0.3, -0.2)));
+  for (const std::uint64_t max_byte_cubes : {std::uint64_t{1} << 24, std::uint64_t{0}}) {
+    CubeGridSettings fs = edge(0.25), cs = edge(0.5), odd = edge(0.3);
+    fs.max_byte_cubes = cs.max_byte_cubes = odd.max_byte_cubes = max_byte_cubes;
+    std::vector<CubeGrid> fine;
+    for (int k = 0; k < 3; ++k) {
+      fs.origin_shift = k / 3.0;
+      fine.push_back(CubeGrid::build(ref, fs));
+    }
+    const CubeGrid coarse_grid = CubeGrid::build(ref, cs), odd_grid = CubeGrid::build(ref, odd);
+    std::vector<CoincidenceObjective> f;
+    for (const CubeGrid& g : fine) f.emplace_back(g, scan);
+    CoincidenceObjective coarse(coarse_grid, scan), other(odd_grid, scan);
+    const Eigen::Vector3d pivot = centroid(scan);
+    MultiScaleObjective together({&f[0], &f[1], &f[2]}, &coarse, 3.0, pivot);
+    MultiScaleObjective one_by_one({&f[0], &other}, &coarse, 3.0, pivot);
+    std::mt19937_64 rng(11);
+    std::uniform_real_distribution<double> u(-1.0, 1.0);
+    for (const SimdPath path : supportedSimdPaths()) {
+      setSimdPath(path);
+      for (int trial = 0; trial < 40; ++trial) {
+        Pose6 p;
+        p << 0.5 * u(rng), 0.5 * u(rng), 0.2 * u(rng), 0.1 * u(rng), 0.1 * u(rng), 0.6 * u(rng);
+        const double expected =
+            double(f[0](p) + f[1](p) + f[2](p)) + 3.0 * double(coarse(p));
+        EXPECT_EQ(together(together.variable(p)), expected) << simdPathName(path);
+        EXPECT_TRUE(together.evaluatedTogether());
+        EXPECT_EQ(one_by_one(one_by_one.variable(p)),
+                  double(f[0](p) + other(p)) + 3.0 * double(coarse(p)));
+        EXPECT_FALSE(one_by_one.evaluatedTogether());
+      }
+      for (const CoincidenceObjective& o : f) EXPECT_TRUE(o.workingCopyRestored());
+      EXPECT_TRUE(coarse.workingCopyRestored());
+    }
+  }
+  setSimdPath(std::nullopt);
 }
 
 TEST(MultiScaleObjective, AnAngleStepTurnsThePointsAboutThePivot) {

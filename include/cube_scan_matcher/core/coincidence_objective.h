@@ -32,6 +32,18 @@ class CoincidenceObjective {
   int evaluate(const Pose6& pose);
   int operator()(const Pose6& pose) { return evaluate(pose); }
 
+  /// J from cube indices computed elsewhere (MultiScaleObjective: several grids at one pose):
+  /// startCount(), then countBlock() with the indices of every scan point on this grid
+  /// (outsideIndex() for a point outside it), in blocks of at most kBlock, then finishCount(),
+  /// which restores the working copy and returns J. evaluate() is these three.
+  void startCount() { j_ = 0; }
+  void countBlock(const std::int32_t* idx, std::size_t m);
+  int finishCount();
+  static constexpr std::size_t kBlock = 1024;  ///< points per index block (stays in L1)
+  const CubeGrid& grid() const { return *grid_; }
+  const PointArray* scan() const { return scan_; }
+  std::int32_t outsideIndex() const { return outside_; }
+
   /// True if the working copy of V equals the grid's V (it must, between evaluations).
   bool workingCopyRestored() const;
   /// The working copy holds a byte per cube (else a bit per cube, as V).
@@ -43,14 +55,13 @@ class CoincidenceObjective {
   }
 
  private:
-  static constexpr std::size_t kBlock = 1024;  // points per index block (stays in L1)
   void initWorkingCopy();  // from *grid_; byte copies must be all zero on entry
   /// Computes the cube indices of the scan block by block and hands each block to
   /// count_block(indices, m): the loop both counters share (inlined, no call per point).
   template <typename CountBlock>
   void forEachIndexBlock(const GridAffine& g, CountBlock&& count_block);
-  int countBytes(const GridAffine& g);
-  int countBits(const GridAffine& g);
+  void countBytes(const std::int32_t* idx, std::size_t m);  // one block, byte mode
+  void countBits(const std::int32_t* idx, std::size_t m);   // one block, bit mode
 
   const CubeGrid* grid_;
   const PointArray* scan_ = nullptr;
@@ -61,6 +72,7 @@ class CoincidenceObjective {
   std::vector<std::int32_t> hits_;  // bit mode: indices cleared in this evaluation (J of them)
   std::vector<std::int32_t> idx_;   // block of cube indices
   std::int32_t outside_ = 0;        // index of the spare zero cube
+  int j_ = 0;                       // J so far in this evaluation
 };
 
 }  // namespace cube_scan_matcher

@@ -114,4 +114,15 @@ void computeCubeIndices(const GridAffine& affine, const Eigen::Vector3f& dims, c
                         const float* y, const float* z, std::size_t n, std::int32_t outside,
                         std::int32_t* idx);
 
+/// computeCubeIndices in two steps, for several grids evaluated at one pose (the refine's):
+/// u = A p [cubes] for a rotation part A (GridAffine::a of one grid) ...
+void rotatePoints(const float (&a)[3][3], const float* x, const float* y, const float* z,
+                  std::size_t n, float* ux, float* uy, float* uz);
+/// ... then per grid the indices of s u + b, with b that grid's GridAffine::b. When that grid's
+/// GridAffine::a equals s A entry for entry and s is a power of two, the indices equal
+/// computeCubeIndices' with that grid's affine (the same roundings).
+void cubeIndicesFromRotated(float s, const float (&b)[3], const Eigen::Vector3f& dims,
+                            const float* ux, const float* uy, const float* uz, std::size_t n,
+                            std::int32_t outside, std::int32_t* idx);
+
 }  // namespace cube_scan_matcher
