@@ -10,8 +10,6 @@
 
 namespace cube_scan_matcher {
 
-using detail::voxelKey;
-
 PointArray collapseToVoxels(const PointArray& in, double voxel) {
   if (!(voxel > 0.0)) throw std::invalid_argument("collapse voxel must be > 0 m");
   const float inv = float(1.0 / voxel);
@@ -19,8 +17,13 @@ PointArray collapseToVoxels(const PointArray& in, double voxel) {
   detail::KeyIndex set(in.size() / 8);
   std::vector<std::uint32_t> keep;
   keep.reserve(in.size() / 8);
-  for (std::size_t i = 0; i < in.size(); ++i) {
-    if (set.insert(voxelKey(in.x[i], in.y[i], in.z[i], inv)).second) keep.push_back(std::uint32_t(i));
+  std::uint64_t keys[detail::kKeyBlock];
+  for (std::size_t begin = 0; begin < in.size(); begin += detail::kKeyBlock) {
+    const std::size_t m = std::min(detail::kKeyBlock, in.size() - begin);
+    detail::voxelKeys(in.x.data() + begin, in.y.data() + begin, in.z.data() + begin, m, inv, keys);
+    for (std::size_t k = 0; k < m; ++k) {
+      if (set.insert(keys[k]).second) keep.push_back(std::uint32_t(begin + k));
+    }
   }
   PointArray out;
   out.reserve(keep.size());

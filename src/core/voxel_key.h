@@ -12,9 +12,11 @@
 namespace cube_scan_matcher::detail {
 
 /// Voxel index of coordinate v along one axis, offset by 2^20 and clamped to [0, 2^21 - 1].
+/// (The product of two floats is exact in double, so every rounding here is exact: voxelKeys()
+/// gives the same keys vectorised. NaN gives index 0.)
 inline std::int64_t voxelIndex(float v, float inv) {
-  const double c = std::floor(double(v) * inv) + double(1 << 20);
-  return std::int64_t(std::min(std::max(c, 0.0), double((1 << 21) - 1)));
+  const double c = std::floor(double(v) * double(inv)) + double(1 << 20);
+  return std::int64_t(std::min(std::max(0.0, c), double((1 << 21) - 1)));
 }
 
 /// Packs three voxel indices of voxelIndex() (each in [0, 2^21 - 1]) into one key.
@@ -26,6 +28,14 @@ inline std::uint64_t packVoxel(std::int64_t ix, std::int64_t iy, std::int64_t iz
 inline std::uint64_t voxelKey(float x, float y, float z, float inv) {
   return packVoxel(voxelIndex(x, inv), voxelIndex(y, inv), voxelIndex(z, inv));
 }
+
+/// voxelKey() of n points (x[i], y[i], z[i]) into keys[i], vectorised on the active SIMD path
+/// (voxel_keys.cpp).
+void voxelKeys(const float* x, const float* y, const float* z, std::size_t n, float inv,
+               std::uint64_t* keys);
+
+/// Points per block of keys: the callers compute a block of keys, then insert them.
+constexpr std::size_t kKeyBlock = 512;
 
 /// Finaliser of MurmurHash3: spreads the packed key over the table's low bits.
 inline std::uint64_t mixKey(std::uint64_t k) {

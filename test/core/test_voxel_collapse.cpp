@@ -1,8 +1,14 @@
 // collapseToVoxels: one point per voxel, the first one kept.
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <cmath>
+#include <random>
+#include <set>
 #include <stdexcept>
+#include <tuple>
 
+#include "cube_scan_matcher/core/simd_path.h"
 #include "cube_scan_matcher/core/voxel_collapse.h"
 
 using namespace cube_scan_matcher;
@@ -56,4 +62,44 @@ TEST(VoxelCollapse, KeepsEveryVoxelWhenThereAreAsManyAsPoints) {
     ASSERT_EQ(out.x[i], in.x[i]);  // the first point of each voxel, in input order
     ASSERT_EQ(out.z[i], in.z[i]);
   }
+}
+
+// The voxel keys are computed a block at a time on the active vector path: every path keeps
+// the points a plain scalar floor(x / voxel) keeps, across blocks, on voxel boundaries, on
+// both sides of the origin and beyond the key range (clamped to its last voxel).
+TEST(VoxelCollapse, EveryVectorPathKeepsThePointsOfTheScalarVoxels) {
+  std::mt19937_64 rng(3);
+  std::uniform_real_distribution<float> u(-30.f, 30.f);
+  PointArray in;
+  for (int i = 0; i < 5000; ++i) in.push_back(u(rng), u(rng), 0.1f * u(rng));
+  for (int i = -40; i <= 40; ++i) {
+    in.push_back(0.125f * float(i), -0.125f * float(i), 0.f);  // on boundaries
+    in.push_back(0.06f * float(i), 0.06f, -0.06f * float(i));  // across the origin
+  }
+  in.push_back(1e9f, -1e9f, 3e8f);  // beyond 2^20 voxels: clamped
+  in.push_back(2e9f, -2e9f, 6e8f);  // the same clamped voxel: dropped
+  const double voxel = 0.125;
+  const float inv = float(1.0 / voxel);
+  auto index = [inv](float v) {
+    const double c = std::floor(double(v) * double(inv)) + double(1 << 20);
+    return std::int64_t(std::min(std::max(0.0, c), double((1 << 21) - 1)));
+  };
+  std::set<std::tuple<std::int64_t, std::int64_t, std::int64_t>> seen;
+  PointArray expected;
+  for (std::size_t i = 0; i < in.size(); ++i) {
+    if (seen.insert({index(in.x[i]), index(in.y[i]), index(in.z[i])}).second) {
+      expected.push_back(in.x[i], in.y[i], in.z[i]);
+    }
+  }
+  ASSERT_LT(expected.size(), in.size());
+  for (const SimdPath path : supportedSimdPaths()) {
+    setSimdPath(path);
+    const PointArray out = collapseToVoxels(in, voxel);
+    ASSERT_EQ(out.size(), expected.size()) << simdPathName(path);
+    EXPECT_TRUE(std::equal(out.x.begin(), out.x.end(), expected.x.begin()) &&
+                std::equal(out.y.begin(), out.y.end(), expected.y.begin()) &&
+                std::equal(out.z.begin(), out.z.end(), expected.z.begin()))
+        << simdPathName(path);
+  }
+  setSimdPath(std::nullopt);
 }
