@@ -9,6 +9,7 @@
 #include <sstream>
 
 #include "cube_scan_matcher/core/simd_path.h"
+#include "simd_clones.h"
 #include "reuse_memory.h"
 
 namespace cube_scan_matcher {
@@ -53,7 +54,7 @@ GridAffine CubeGrid::affine(const Eigen::Matrix3f& rotation,
 
 // The hot loop. The body is written once, inlined into one function per instruction set
 // (x86-64: AVX-512F, AVX2 and the baseline; elsewhere, e.g. aarch64 with NEON as its
-// baseline, only the baseline) and picked through simd_path.h. `omp simd` (with
+// baseline, only the baseline: simd_clones.h) and picked through simd_path.h. `omp simd` (with
 // -fopenmp-simd, no OpenMP runtime) makes GCC vectorise each copy at -O2. This file is built
 // with -ffp-contract=off (CMakeLists.txt): no copy fuses a multiply and an add into an FMA
 // (the AVX-512 one did, AVX-512F having FMA of its own), so every copy rounds the same
@@ -124,80 +125,20 @@ inline __attribute__((always_inline)) void indicesFromRotatedBody(
   }
 }
 
-using IndexKernel = void (*)(const GridAffine&, const Eigen::Vector3f&, const float*,
-                             const float*, const float*, std::size_t, std::int32_t,
-                             std::int32_t*);
-using RotateKernel = void (*)(const float (&)[3][3], const float*, const float*, const float*,
-                              std::size_t, float*, float*, float*);
-using RotatedIndexKernel = void (*)(float, const float (&)[3], const Eigen::Vector3f&,
-                                    const float*, const float*, const float*, std::size_t,
-                                    std::int32_t, std::int32_t*);
-
-/// One function per instruction set for each body (see above).
-#define CSM_SIMD_CLONES(target_attr, suffix)                                                   \
-  target_attr void rotate##suffix(const float (&a)[3][3], const float* x, const float* y,      \
-                                  const float* z, std::size_t n, float* ux, float* uy,         \
-                                  float* uz) {                                                 \
-    rotateBody(a, x, y, z, n, ux, uy, uz);                                                     \
-  }                                                                                            \
-  target_attr void indicesFromRotated##suffix(                                                 \
-      float s, const float (&b)[3], const Eigen::Vector3f& dims, const float* ux,              \
-      const float* uy, const float* uz, std::size_t n, std::int32_t outside,                   \
-      std::int32_t* idx) {                                                                     \
-    indicesFromRotatedBody(s, b, dims, ux, uy, uz, n, outside, idx);                           \
-  }
-
-CSM_SIMD_CLONES(, Portable)
-
-void cubeIndicesPortable(const GridAffine& g, const Eigen::Vector3f& dims, const float* x,
-                         const float* y, const float* z, std::size_t n, std::int32_t outside,
-                         std::int32_t* idx) {
-  cubeIndicesBody(g, dims, x, y, z, n, outside, idx);
-}
-
-#if defined(__x86_64__) && defined(__GNUC__)
-#define CSM_HAVE_X86_PATHS 1
-__attribute__((target("avx2"))) void cubeIndicesAvx2(
-    const GridAffine& g, const Eigen::Vector3f& dims, const float* x, const float* y,
-    const float* z, std::size_t n, std::int32_t outside, std::int32_t* idx) {
-  cubeIndicesBody(g, dims, x, y, z, n, outside, idx);
-}
-__attribute__((target("avx512f"))) void cubeIndicesAvx512(
-    const GridAffine& g, const Eigen::Vector3f& dims, const float* x, const float* y,
-    const float* z, std::size_t n, std::int32_t outside, std::int32_t* idx) {
-  cubeIndicesBody(g, dims, x, y, z, n, outside, idx);
-}
-CSM_SIMD_CLONES(__attribute__((target("avx2"))), Avx2)
-CSM_SIMD_CLONES(__attribute__((target("avx512f"))), Avx512)
-#endif
-#undef CSM_SIMD_CLONES
-
-IndexKernel kernelFor(SimdPath path) {
-#ifdef CSM_HAVE_X86_PATHS
-  if (path == SimdPath::Avx512) return cubeIndicesAvx512;
-  if (path == SimdPath::Avx2) return cubeIndicesAvx2;
-#endif
-  (void)path;
-  return cubeIndicesPortable;
-}
-
-RotateKernel rotateKernelFor(SimdPath path) {
-#ifdef CSM_HAVE_X86_PATHS
-  if (path == SimdPath::Avx512) return rotateAvx512;
-  if (path == SimdPath::Avx2) return rotateAvx2;
-#endif
-  (void)path;
-  return rotatePortable;
-}
-
-RotatedIndexKernel rotatedIndexKernelFor(SimdPath path) {
-#ifdef CSM_HAVE_X86_PATHS
-  if (path == SimdPath::Avx512) return indicesFromRotatedAvx512;
-  if (path == SimdPath::Avx2) return indicesFromRotatedAvx2;
-#endif
-  (void)path;
-  return indicesFromRotatedPortable;
-}
+CSM_SIMD_CLONES(cubeIndices,
+                (const GridAffine& g, const Eigen::Vector3f& dims, const float* x,
+                 const float* y, const float* z, std::size_t n, std::int32_t outside,
+                 std::int32_t* idx),
+                (g, dims, x, y, z, n, outside, idx))
+CSM_SIMD_CLONES(rotate,
+                (const float (&a)[3][3], const float* x, const float* y, const float* z,
+                 std::size_t n, float* ux, float* uy, float* uz),
+                (a, x, y, z, n, ux, uy, uz))
+CSM_SIMD_CLONES(indicesFromRotated,
+                (float s, const float (&b)[3], const Eigen::Vector3f& dims, const float* ux,
+                 const float* uy, const float* uz, std::size_t n, std::int32_t outside,
+                 std::int32_t* idx),
+                (s, b, dims, ux, uy, uz, n, outside, idx))
 
 /// Every path, fastest first.
 constexpr SimdPath kAllPaths[] = {SimdPath::Avx512, SimdPath::Avx2, SimdPath::Portable};
@@ -222,7 +163,7 @@ SimdPath initialPath() {
   return best;
 }
 
-/// The active path; its kernel is looked up once per block of points (kernelFor).
+/// The active path; its copy of a loop is picked once per block of points (CSM_PICK_CLONE).
 std::atomic<SimdPath>& activePath() {
   static std::atomic<SimdPath> path(initialPath());
   return path;
@@ -286,18 +227,18 @@ std::string simdReport() {
 void computeCubeIndices(const GridAffine& g, const Eigen::Vector3f& dims, const float* x,
                         const float* y, const float* z, std::size_t n, std::int32_t outside,
                         std::int32_t* idx) {
-  kernelFor(activeSimdPath())(g, dims, x, y, z, n, outside, idx);
+  CSM_PICK_CLONE(cubeIndices, activeSimdPath())(g, dims, x, y, z, n, outside, idx);
 }
 
 void rotatePoints(const float (&a)[3][3], const float* x, const float* y, const float* z,
                   std::size_t n, float* ux, float* uy, float* uz) {
-  rotateKernelFor(activeSimdPath())(a, x, y, z, n, ux, uy, uz);
+  CSM_PICK_CLONE(rotate, activeSimdPath())(a, x, y, z, n, ux, uy, uz);
 }
 
 void cubeIndicesFromRotated(float s, const float (&b)[3], const Eigen::Vector3f& dims,
                             const float* ux, const float* uy, const float* uz, std::size_t n,
                             std::int32_t outside, std::int32_t* idx) {
-  rotatedIndexKernelFor(activeSimdPath())(s, b, dims, ux, uy, uz, n, outside, idx);
+  CSM_PICK_CLONE(indicesFromRotated, activeSimdPath())(s, b, dims, ux, uy, uz, n, outside, idx);
 }
 
 CubeGrid CubeGrid::build(const PointArray& ref, const CubeGridSettings& settings) {

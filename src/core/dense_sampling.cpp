@@ -1,6 +1,5 @@
 #include "cube_scan_matcher/core/dense_sampling.h"
 
-#include <algorithm>
 #include <cstdint>
 #include <stdexcept>
 #include <vector>
@@ -17,18 +16,12 @@ PointArray keepDenselySampled(const PointArray& points, double edge, int min_poi
   detail::KeyIndex set(points.size() / 8);
   std::vector<std::uint32_t> count;  // points per cube, by the cube's index
   std::vector<std::uint32_t> cube_of(points.size());
-  std::uint64_t keys[detail::kKeyBlock];
-  for (std::size_t begin = 0; begin < points.size(); begin += detail::kKeyBlock) {
-    const std::size_t m = std::min(detail::kKeyBlock, points.size() - begin);
-    detail::voxelKeys(points.x.data() + begin, points.y.data() + begin, points.z.data() + begin,
-                      m, inv, keys);
-    for (std::size_t k = 0; k < m; ++k) {
-      const auto [index, added] = set.insert(keys[k]);
-      if (added) count.push_back(0);
-      cube_of[begin + k] = index;
-      ++count[index];
-    }
-  }
+  detail::forEachVoxelKey(points, inv, [&](std::size_t i, std::uint64_t key) {
+    const auto [index, added] = set.insert(key);
+    if (added) count.push_back(0);
+    cube_of[i] = index;
+    ++count[index];
+  });
   PointArray out;
   out.reserve(points.size());
   for (std::size_t i = 0; i < points.size(); ++i) {

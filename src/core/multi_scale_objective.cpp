@@ -9,7 +9,10 @@ namespace cube_scan_matcher {
 MultiScaleObjective::MultiScaleObjective(std::vector<CoincidenceObjective*> fine,
                                          CoincidenceObjective* coarse, double coarse_weight,
                                          const Eigen::Vector3d& pivot)
-    : fine_(std::move(fine)), coarse_(coarse), coarse_weight_(coarse_weight), pivot_(pivot) {}
+    : fine_(std::move(fine)), coarse_(coarse), coarse_weight_(coarse_weight), pivot_(pivot) {
+  all_ = fine_;
+  if (coarse_weight_ > 0.0) all_.push_back(coarse_);
+}
 
 double MultiScaleObjective::operator()(const Vector6d& q) {
   const Pose6 p = pose(q);
@@ -25,21 +28,19 @@ double MultiScaleObjective::operator()(const Vector6d& q) {
 bool MultiScaleObjective::evaluateTogether(const Pose6& p, int& fine_sum, int& coarse_j) {
   // The grids' affines at p: their rotation parts must be power-of-two multiples of the first
   // one's, entry for entry (edges E / 2^k), and the objectives must share one scan.
-  std::vector<CoincidenceObjective*>& all = together_;
-  all.assign(fine_.begin(), fine_.end());
-  if (coarse_weight_ > 0.0) all.push_back(coarse_);
-  if (all.size() < 2) return false;
-  const PointArray* scan = all.front()->scan();
+  if (all_.size() < 2) return false;
+  const PointArray* scan = all_.front()->scan();
   if (!scan || scan->empty()) return false;
   const Eigen::Isometry3d t = poseToIsometry(p);
   const Eigen::Matrix3f r = t.linear().cast<float>();
   const Eigen::Vector3f tr = t.translation().cast<float>();
-  affines_.resize(all.size());
-  scales_.resize(all.size());
-  for (std::size_t k = 0; k < all.size(); ++k) {
-    if (all[k]->scan() != scan) return false;
-    affines_[k] = all[k]->grid().affine(r, tr);
-    const float s = float(1.0 / all[k]->grid().edge()) / float(1.0 / all.front()->grid().edge());
+  affines_.resize(all_.size());
+  scales_.resize(all_.size());
+  for (std::size_t k = 0; k < all_.size(); ++k) {
+    if (all_[k]->scan() != scan) return false;
+    affines_[k] = all_[k]->grid().affine(r, tr);
+    const float s =
+        float(1.0 / all_[k]->grid().edge()) / float(1.0 / all_.front()->grid().edge());
     int e = 0;
     if (!(std::frexp(s, &e) == 0.5f)) return false;  // not a power of two
     for (int i = 0; i < 3; ++i) {
@@ -52,15 +53,15 @@ bool MultiScaleObjective::evaluateTogether(const Pose6& p, int& fine_sum, int& c
   // One rotation per block, then the indices and the count on each grid.
   constexpr std::size_t kBlock = CoincidenceObjective::kBlock;
   ux_.resize(kBlock), uy_.resize(kBlock), uz_.resize(kBlock), idx_.resize(kBlock);
-  for (CoincidenceObjective* o : all) o->startCount();
+  for (CoincidenceObjective* o : all_) o->startCount();
   for (std::size_t begin = 0; begin < scan->size(); begin += kBlock) {
     const std::size_t m = std::min(kBlock, scan->size() - begin);
     rotatePoints(affines_[0].a, scan->x.data() + begin, scan->y.data() + begin,
                  scan->z.data() + begin, m, ux_.data(), uy_.data(), uz_.data());
-    for (std::size_t k = 0; k < all.size(); ++k) {
-      cubeIndicesFromRotated(scales_[k], affines_[k].b, all[k]->grid().dimsF(), ux_.data(),
-                             uy_.data(), uz_.data(), m, all[k]->outsideIndex(), idx_.data());
-      all[k]->countBlock(idx_.data(), m);
+    for (std::size_t k = 0; k < all_.size(); ++k) {
+      cubeIndicesFromRotated(scales_[k], affines_[k].b, all_[k]->grid().dimsF(), ux_.data(),
+                             uy_.data(), uz_.data(), m, all_[k]->outsideIndex(), idx_.data());
+      all_[k]->countBlock(idx_.data(), m);
     }
   }
   fine_sum = 0;

@@ -1,6 +1,5 @@
 #include "cube_scan_matcher/core/plane_map.h"
 
-#include <algorithm>
 #include <cmath>
 #include <stdexcept>
 
@@ -40,18 +39,12 @@ void PlaneMap::rebuild(const PointArray& reference, double voxel, int min_points
   // 104-byte sums would copy it over and over).
   reserveForRebuild(voxel_of_, reference.size());
   voxel_of_.assign(reference.size(), detail::KeyIndex::kNone);
-  std::uint64_t keys[detail::kKeyBlock];
-  for (std::size_t begin = 0; begin < reference.size(); begin += detail::kKeyBlock) {
-    const std::size_t m = std::min(detail::kKeyBlock, reference.size() - begin);
-    detail::voxelKeys(reference.x.data() + begin, reference.y.data() + begin,
-                      reference.z.data() + begin, m, inv_, keys);
-    for (std::size_t k = 0; k < m; ++k) {
-      const std::size_t i = begin + k;
-      const float x = reference.x[i], y = reference.y[i], z = reference.z[i];
-      if (!std::isfinite(x) || !std::isfinite(y) || !std::isfinite(z)) continue;
-      voxel_of_[i] = keys_->insert(keys[k]).first;
+  detail::forEachVoxelKey(reference, inv_, [&](std::size_t i, std::uint64_t key) {
+    const float x = reference.x[i], y = reference.y[i], z = reference.z[i];
+    if (std::isfinite(x) && std::isfinite(y) && std::isfinite(z)) {
+      voxel_of_[i] = keys_->insert(key).first;
     }
-  }
+  });
   reserveForRebuild(stats_, keys_->size());
   stats_.assign(keys_->size(), Stats());
   for (std::size_t i = 0; i < reference.size(); ++i) {

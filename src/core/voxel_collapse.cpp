@@ -17,14 +17,9 @@ PointArray collapseToVoxels(const PointArray& in, double voxel) {
   detail::KeyIndex set(in.size() / 8);
   std::vector<std::uint32_t> keep;
   keep.reserve(in.size() / 8);
-  std::uint64_t keys[detail::kKeyBlock];
-  for (std::size_t begin = 0; begin < in.size(); begin += detail::kKeyBlock) {
-    const std::size_t m = std::min(detail::kKeyBlock, in.size() - begin);
-    detail::voxelKeys(in.x.data() + begin, in.y.data() + begin, in.z.data() + begin, m, inv, keys);
-    for (std::size_t k = 0; k < m; ++k) {
-      if (set.insert(keys[k]).second) keep.push_back(std::uint32_t(begin + k));
-    }
-  }
+  detail::forEachVoxelKey(in, inv, [&](std::size_t i, std::uint64_t key) {
+    if (set.insert(key).second) keep.push_back(std::uint32_t(i));
+  });
   PointArray out;
   out.reserve(keep.size());
   for (std::uint32_t i : keep) out.push_back(in.x[i], in.y[i], in.z[i]);

@@ -9,33 +9,42 @@
 #include <utility>
 #include <vector>
 
+#include "cube_scan_matcher/core/point_array.h"
+
 namespace cube_scan_matcher::detail {
 
 /// Voxel index of coordinate v along one axis, offset by 2^20 and clamped to [0, 2^21 - 1].
 /// (The product of two floats is exact in double, so every rounding here is exact: voxelKeys()
-/// gives the same keys vectorised. NaN gives index 0.)
+/// gives the same indices vectorised. NaN gives index 0.)
 inline std::int64_t voxelIndex(float v, float inv) {
   const double c = std::floor(double(v) * double(inv)) + double(1 << 20);
   return std::int64_t(std::min(std::max(0.0, c), double((1 << 21) - 1)));
 }
 
-/// Packs three voxel indices of voxelIndex() (each in [0, 2^21 - 1]) into one key.
+/// Packs three voxel indices of voxelIndex() (each in [0, 2^21 - 1]) into one key: 21 bits per
+/// axis, +-2^20 voxels of edge 1/inv around the origin (clamped beyond).
 inline std::uint64_t packVoxel(std::int64_t ix, std::int64_t iy, std::int64_t iz) {
   return std::uint64_t(ix) | (std::uint64_t(iy) << 21) | (std::uint64_t(iz) << 42);
 }
 
-/// 21 bits per axis: +-2^20 voxels of edge 1/inv around the origin (clamped beyond).
-inline std::uint64_t voxelKey(float x, float y, float z, float inv) {
-  return packVoxel(voxelIndex(x, inv), voxelIndex(y, inv), voxelIndex(z, inv));
-}
-
-/// voxelKey() of n points (x[i], y[i], z[i]) into keys[i], vectorised on the active SIMD path
-/// (voxel_keys.cpp).
+/// The keys packVoxel(voxelIndex(x[i]), voxelIndex(y[i]), voxelIndex(z[i])) of n points into
+/// keys[i], vectorised on the active SIMD path (voxel_keys.cpp).
 void voxelKeys(const float* x, const float* y, const float* z, std::size_t n, float inv,
                std::uint64_t* keys);
 
-/// Points per block of keys: the callers compute a block of keys, then insert them.
-constexpr std::size_t kKeyBlock = 512;
+/// Calls f(i, key) for every point i of `points` in order, the keys computed by voxelKeys() a
+/// block at a time.
+template <typename F>
+void forEachVoxelKey(const PointArray& points, float inv, F&& f) {
+  constexpr std::size_t kBlock = 512;
+  std::uint64_t keys[kBlock];
+  for (std::size_t begin = 0; begin < points.size(); begin += kBlock) {
+    const std::size_t m = std::min(kBlock, points.size() - begin);
+    voxelKeys(points.x.data() + begin, points.y.data() + begin, points.z.data() + begin, m, inv,
+              keys);
+    for (std::size_t k = 0; k < m; ++k) f(begin + k, keys[k]);
+  }
+}
 
 /// Finaliser of MurmurHash3: spreads the packed key over the table's low bits.
 inline std::uint64_t mixKey(std::uint64_t k) {

@@ -5,7 +5,7 @@
 #include <cmath>
 #include <cstdint>
 
-#include "cube_scan_matcher/core/simd_path.h"
+#include "simd_clones.h"
 #include "voxel_key.h"
 
 namespace cube_scan_matcher::detail {
@@ -27,42 +27,16 @@ inline __attribute__((always_inline)) void voxelKeysBody(const float* x, const f
   }
 }
 
-using KeyKernel = void (*)(const float*, const float*, const float*, std::size_t, float,
-                           std::uint64_t*);
-
-void voxelKeysPortable(const float* x, const float* y, const float* z, std::size_t n, float inv,
-                       std::uint64_t* keys) {
-  voxelKeysBody(x, y, z, n, inv, keys);
-}
-
-#if defined(__x86_64__) && defined(__GNUC__)
-#define CSM_HAVE_X86_PATHS 1
-__attribute__((target("avx2"))) void voxelKeysAvx2(const float* x, const float* y,
-                                                   const float* z, std::size_t n, float inv,
-                                                   std::uint64_t* keys) {
-  voxelKeysBody(x, y, z, n, inv, keys);
-}
-__attribute__((target("avx512f"))) void voxelKeysAvx512(
-    const float* x, const float* y, const float* z, std::size_t n, float inv,
-    std::uint64_t* keys) {
-  voxelKeysBody(x, y, z, n, inv, keys);
-}
-#endif
-
-KeyKernel keyKernelFor(SimdPath path) {
-#ifdef CSM_HAVE_X86_PATHS
-  if (path == SimdPath::Avx512) return voxelKeysAvx512;
-  if (path == SimdPath::Avx2) return voxelKeysAvx2;
-#endif
-  (void)path;
-  return voxelKeysPortable;
-}
+CSM_SIMD_CLONES(voxelKeys,
+                (const float* x, const float* y, const float* z, std::size_t n, float inv,
+                 std::uint64_t* keys),
+                (x, y, z, n, inv, keys))
 
 }  // namespace
 
 void voxelKeys(const float* x, const float* y, const float* z, std::size_t n, float inv,
                std::uint64_t* keys) {
-  keyKernelFor(activeSimdPath())(x, y, z, n, inv, keys);
+  CSM_PICK_CLONE(voxelKeys, activeSimdPath())(x, y, z, n, inv, keys);
 }
 
 }  // namespace cube_scan_matcher::detail

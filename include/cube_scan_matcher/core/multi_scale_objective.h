@@ -45,8 +45,8 @@ class MultiScaleObjective {
   CoincidenceObjective* coarse_;
   double coarse_weight_;
   Eigen::Vector3d pivot_;
+  std::vector<CoincidenceObjective*> all_;  // fine_, then coarse_ when it is weighted
   // evaluateTogether's buffers, reused by every evaluation.
-  std::vector<CoincidenceObjective*> together_;
   std::vector<GridAffine> affines_;
   std::vector<float> scales_, ux_, uy_, uz_;
   std::vector<std::int32_t> idx_;
