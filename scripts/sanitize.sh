@@ -59,7 +59,8 @@ if [ "$WHAT" = asan ] || [ "$WHAT" = all ]; then
   configure build-asan "$FLAGS"
   echo "== sanitize: building build-asan (log in build-asan.log)"
   make -C build-asan -j"$(nproc)" test_core test_io test_cloud_conversion register_clouds \
-    benchmark clouds_to_bag scan_matcher_node cube_scan_matcher_nodelet test_scan_matcher_ros test_faults \
+    benchmark clouds_to_bag scan_matcher_node cube_scan_matcher_nodelet \
+    cube_scan_matcher_assembler_nodelet test_scan_matcher_ros test_faults test_unload \
     >> build-asan.log 2>&1 || { tail -40 build-asan.log; exit 1; }
   BIN="$ROOT/build-asan/devel/lib/cube_scan_matcher"
   export ASAN_OPTIONS="log_path=$REPORTS/asan:detect_leaks=1:abort_on_error=0:exitcode=86"
@@ -83,6 +84,8 @@ if [ "$WHAT" = asan ] || [ "$WHAT" = all ]; then
     rostest cube_scan_matcher bad_param.test prefix:="env LD_PRELOAD=$LIBASAN"
   step "rostest faults.test (ASan+UBSan, manager preloaded)" \
     rostest cube_scan_matcher faults.test prefix:="env LD_PRELOAD=$LIBASAN"
+  step "rostest unload.test (ASan+UBSan: nodelets destroyed after their unload)" \
+    rostest cube_scan_matcher unload.test
   unset ASAN_OPTIONS UBSAN_OPTIONS LSAN_OPTIONS
 fi
 

@@ -43,6 +43,7 @@ boost::array<double, 36> covariance(double sigma_m, double sigma_deg) {
 ScanMatcherNodelet::~ScanMatcherNodelet() = default;
 
 void ScanMatcherNodelet::onInit() {
+  queues_.hold(getSTCallbackQueue(), getMTCallbackQueue());
   ros::NodeHandle& nh = getNodeHandle();
   ros::NodeHandle& pnh = getPrivateNodeHandle();
   updater_ = std::make_unique<diagnostic_updater::Updater>(nh, pnh, getName());

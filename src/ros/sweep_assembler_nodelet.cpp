@@ -97,6 +97,7 @@ SweepAssemblerNodelet::~SweepAssemblerNodelet() {
 }
 
 void SweepAssemblerNodelet::onInit() {
+  queues_.hold(getSTCallbackQueue(), getMTCallbackQueue());
   ros::NodeHandle& nh = getNodeHandle();
   ros::NodeHandle& pnh = getPrivateNodeHandle();
   updater_ = std::make_unique<diagnostic_updater::Updater>(nh, pnh, getName());

@@ -26,6 +26,7 @@
 #include "cube_scan_matcher/Status.h"
 #include "cube_scan_matcher/core/online_matcher.h"
 #include "cube_scan_matcher/core/pose_covariance.h"
+#include "cube_scan_matcher/ros/nodelet_queues.h"
 #include "cube_scan_matcher/ros/params.h"
 
 namespace cube_scan_matcher {
@@ -70,6 +71,8 @@ class ScanMatcherNodelet : public nodelet::Nodelet {
   void resetState(const std::string& why);
   void diagnose(diagnostic_updater::DiagnosticStatusWrapper& stat);
 
+  // First member, so destroyed last: every handle below goes while its queue still lives.
+  NodeletQueues queues_;
   NodeParams params_;
   std::unique_ptr<OnlineMatcher> matcher_;
   std::mutex mutex_;  // guards everything below: callbacks may run on several manager threads

@@ -27,6 +27,7 @@
 #include <tf2_ros/transform_listener.h>
 
 #include "cube_scan_matcher/assembly/sweep_cutter.h"
+#include "cube_scan_matcher/ros/nodelet_queues.h"
 
 namespace cube_scan_matcher {
 
@@ -88,6 +89,8 @@ class SweepAssemblerNodelet : public nodelet::Nodelet {
   void dropWaiting(const Waiting& w, const std::string& why);
   void diagnose(diagnostic_updater::DiagnosticStatusWrapper& stat);
 
+  // First member, so destroyed last: every handle below goes while its queue still lives.
+  NodeletQueues queues_;
   AssemblerParams params_;
   std::unique_ptr<SweepCutter> cutter_;
   laser_geometry::LaserProjection projector_;
