@@ -40,7 +40,18 @@ boost::array<double, 36> covariance(double sigma_m, double sigma_deg) {
 
 }  // namespace
 
-ScanMatcherNodelet::~ScanMatcherNodelet() = default;
+ScanMatcherNodelet::~ScanMatcherNodelet() {
+  // Stop every source of callbacks before any member goes: members are destroyed in reverse
+  // order, so with the default destructor a timer or cloud callback already queued could run
+  // on a manager thread against members destroyed before its handle. Each stop waits for a
+  // callback of its own that is running (roscpp's removeByID).
+  tf_timer_.stop();
+  diagnostics_timer_.stop();
+  cloud_sub_.shutdown();
+  reset_srv_.shutdown();
+  set_pose_srv_.shutdown();
+  reconfigure_server_.reset();
+}
 
 void ScanMatcherNodelet::onInit() {
   queues_.hold(getSTCallbackQueue(), getMTCallbackQueue());

@@ -18,22 +18,42 @@ using namespace cube_scan_matcher;
 
 namespace {
 
-/// Loads `type` as `name`, lets its callbacks run for `run` seconds, unloads it and returns the
-/// nodelet, which the caller now owns alone (as a manager thread finishing a callback would).
-boost::shared_ptr<nodelet::Nodelet> loadRunUnload(const std::string& name, const std::string& type,
-                                                  double run) {
-  boost::shared_ptr<nodelet::Nodelet> kept;
-  nodelet::Loader loader([&kept](const std::string& t) -> boost::shared_ptr<nodelet::Nodelet> {
-    if (t == "ScanMatcherNodelet") kept = boost::make_shared<ScanMatcherNodelet>();
-    if (t == "SweepAssemblerNodelet") kept = boost::make_shared<SweepAssemblerNodelet>();
-    return kept;
-  });
+/// Loads `type` as `name` into `loader`, lets its callbacks run for `run` seconds, unloads it
+/// and returns the nodelet, which the caller now owns alone (as a manager thread finishing a
+/// callback would). The loader (the manager) stays: in a manager process it outlives every
+/// nodelet, and its queue manager is what the nodelet's queues report new callbacks to.
+boost::shared_ptr<nodelet::Nodelet> loadRunUnload(nodelet::Loader& loader,
+                                                  const boost::shared_ptr<nodelet::Nodelet>& made,
+                                                  const std::string& name,
+                                                  const std::string& type, double run) {
   EXPECT_TRUE(loader.load(name, type, {}, {}));
-  EXPECT_TRUE(kept);
+  EXPECT_TRUE(made);
   ros::WallDuration(run).sleep();
   EXPECT_TRUE(loader.unload(name));
   EXPECT_EQ(loader.listLoadedNodelets().size(), 0u);
-  return kept;  // the loader (and its worker threads) goes; the nodelet stays
+  return made;
+}
+
+/// Runs loadRunUnload 20 times, each with a new loader, dropping the last reference to the
+/// nodelet (its destructor: every handle released after the manager let go of its queues)
+/// before the loader goes.
+void unloadTwentyTimes(const std::string& name, const std::string& type) {
+  for (int i = 0; i < 20; ++i) {
+    boost::shared_ptr<nodelet::Nodelet> made;
+    nodelet::Loader loader([&made](const std::string& t) -> boost::shared_ptr<nodelet::Nodelet> {
+      if (t == "ScanMatcherNodelet") made = boost::make_shared<ScanMatcherNodelet>();
+      if (t == "SweepAssemblerNodelet") made = boost::make_shared<SweepAssemblerNodelet>();
+      return made;
+    });
+    auto kept = loadRunUnload(loader, made, name, type, 0.05);
+    made.reset();
+    ASSERT_TRUE(kept);
+    // A manager thread finishing a callback may still hold a reference for a moment.
+    const ros::WallTime deadline = ros::WallTime::now() + ros::WallDuration(2.0);
+    while (kept.use_count() > 1 && ros::WallTime::now() < deadline) ros::WallDuration(0.001).sleep();
+    EXPECT_EQ(kept.use_count(), 1);
+    kept.reset();
+  }
 }
 
 }  // namespace
@@ -43,22 +63,12 @@ TEST(Unload, ScanMatcherOutlivingItsUnloadIsDestroyedSafely) {
   // queue's diagnostics timer, subscriber, services and dynamic_reconfigure server.
   ros::param::set("/unload_test/scan_matcher/publish_tf", true);
   ros::param::set("/unload_test/scan_matcher/tf_rate", 100.0);
-  for (int i = 0; i < 20; ++i) {
-    auto kept = loadRunUnload("/unload_test/scan_matcher", "ScanMatcherNodelet", 0.05);
-    ASSERT_TRUE(kept);
-    EXPECT_EQ(kept.use_count(), 1);
-    kept.reset();  // ~ScanMatcherNodelet: every handle released after its queue's owner left
-  }
+  unloadTwentyTimes("/unload_test/scan_matcher", "ScanMatcherNodelet");
   EXPECT_TRUE(ros::ok());
 }
 
 TEST(Unload, SweepAssemblerOutlivingItsUnloadIsDestroyedSafely) {
-  for (int i = 0; i < 20; ++i) {
-    auto kept = loadRunUnload("/unload_test/sweep_assembler", "SweepAssemblerNodelet", 0.05);
-    ASSERT_TRUE(kept);
-    EXPECT_EQ(kept.use_count(), 1);
-    kept.reset();
-  }
+  unloadTwentyTimes("/unload_test/sweep_assembler", "SweepAssemblerNodelet");
   EXPECT_TRUE(ros::ok());
 }
 
