@@ -9,6 +9,7 @@
 
 #include "cube_scan_matcher/core/deskew.h"
 #include "require_in_range.h"
+#include "voxel_key.h"
 
 namespace cube_scan_matcher {
 
@@ -32,6 +33,8 @@ void validate(const PolishSettings& s) {
   requireInRange("polish.support_cosine", s.support_cosine, 0.0, 0.999);
   requireInRange("polish.degenerate_sigma_m", s.degenerate_sigma_m, 0.0, 1e3);
   requireInRange("polish.covariance_scale", s.covariance_scale, 1.0, 1e6);
+  requireInRange("polish.covariance_cell_m", s.covariance_cell_m, 0.0, 100.0);
+  requireInRange("polish.covariance_cell_scale", s.covariance_cell_scale, 0.0, 1e6);
 }
 
 namespace {
@@ -50,10 +53,14 @@ struct Linearisation {
   int count = 0;
 };
 
-/// One correspondence's plane normal and weight (its Jacobian's translation part).
+/// One correspondence: its plane normal and weight (the Jacobian's translation part), its
+/// term w r J of the gradient and its plane's mean (in the reference frame; not the scan
+/// point's position, whose noise would sort points across a cube's face by their residual).
 struct Row {
   Eigen::Vector3d n;
   double w;
+  Vector6 wrJ;
+  Eigen::Vector3f m;
 };
 
 /// With `near`, also collects the scan points that found a plane (the only ones the later
@@ -83,7 +90,7 @@ Linearisation linearise(const PlaneMap& map, const PointArray& scan, const Eigen
     J.tail<3>() = rp.cross(plane->normal);
     if (scale) J *= double((*scale)[i]);
     L.H.selfadjointView<Eigen::Upper>().rankUpdate(J, w);
-    if (rows) rows->push_back({plane->normal, w});
+    if (rows) rows->push_back({plane->normal, w, (w * r) * J, plane->mean.cast<float>()});
     L.g.noalias() += (w * r) * J;
     L.weight += w;
     L.weighted_r2 += w * r * r;
@@ -121,6 +128,32 @@ Vector6 step(const Linearisation& L, const Spectrum& s, double weak_ratio) {
     u -= v * (v.dot(gs) / lambda);
   }
   return s.scale.asDiagonal() * u;
+}
+
+/// The clustered ("sandwich") covariance H^-1 B H^-1 with B = sum over cells c of g_c g_c^T,
+/// g_c the sum of the terms w r J of the correspondences in cell c (cubes of edge `cell` [m]
+/// in the reference frame): residuals that share a surface's model error (a trunk's tangent
+/// plane met by points on another side of the trunk) count once per cell, not once per point.
+/// H^-1 = S inv_s S (inv_s: the floored inverse of the scaled H, S = diag(scale)).
+Matrix6 clusteredCovariance(const std::vector<Row>& rows, double cell, const Vector6& scale,
+                            const Matrix6& inv_s) {
+  const float inv = float(1.0 / cell);
+  detail::KeyIndex index(rows.size() / 8);
+  std::vector<Vector6> cells;
+  for (const Row& row : rows) {
+    const auto [c, fresh] =
+        index.insert(detail::packVoxel(detail::voxelIndex(row.m.x(), inv),
+                                       detail::voxelIndex(row.m.y(), inv),
+                                       detail::voxelIndex(row.m.z(), inv)));
+    if (fresh) cells.push_back(Vector6::Zero());
+    cells[c] += row.wrJ;
+  }
+  Matrix6 B = Matrix6::Zero();
+  for (const Vector6& c : cells) {
+    const Vector6 g = scale.asDiagonal() * c;
+    B.noalias() += g * g.transpose();
+  }
+  return scale.asDiagonal() * inv_s * B * inv_s * scale.asDiagonal();
 }
 
 double radiusOfGyration(const PointArray& points) {
@@ -210,6 +243,10 @@ PolishResult polishOnPlanes(const PlaneMap& map, const PointArray& scan, const P
   }
   res.covariance = s.covariance_scale * sigma2 * sp.scale.asDiagonal() * inv_s *
                    sp.scale.asDiagonal();
+  if (s.covariance_cell_m > 0.0 && s.covariance_cell_scale > 0.0) {
+    res.covariance += s.covariance_cell_scale *
+                      clusteredCovariance(rows, s.covariance_cell_m, sp.scale, inv_s);
+  }
   res.weak_ratio = sp.max_eigenvalue > 0.0 ? sp.eig.eigenvalues()(0) / sp.max_eigenvalue : 0.0;
   res.weak_direction = sp.eig.eigenvectors().col(0);
 

@@ -54,6 +54,8 @@ void configToSettings(const ScanMatcherConfig& c, OnlineMatcherSettings& m) {
   r.polish.voxel_fraction = c.polish_voxel_fraction;
   r.polish.kernel = c.polish_kernel;
   r.polish.covariance_scale = c.covariance_scale;
+  r.polish.covariance_cell_m = c.covariance_cell;
+  r.polish.covariance_cell_scale = c.covariance_cell_scale;
   m.gate.min_overlap = c.min_overlap;
   m.gate.min_j_gain = c.min_j_gain;
   m.gate.max_correction_m = c.max_correction_translation;
@@ -142,6 +144,8 @@ ScanMatcherConfig toConfig(const NodeParams& p) {
   c.polish_voxel_fraction = r.polish.voxel_fraction;
   c.polish_kernel = r.polish.kernel;
   c.covariance_scale = r.polish.covariance_scale;
+  c.covariance_cell = r.polish.covariance_cell_m;
+  c.covariance_cell_scale = r.polish.covariance_cell_scale;
   c.min_overlap = p.matcher.gate.min_overlap;
   c.min_j_gain = p.matcher.gate.min_j_gain;
   c.max_correction_translation = p.matcher.gate.max_correction_m;

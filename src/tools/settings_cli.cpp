@@ -68,6 +68,9 @@ std::string algorithmOptionsHelp() {
          "                        the strongest information (default " + num(d.polish.weak_ratio) + ")\n"
          "  --polish-iterations N Gauss-Newton steps of the polish (default " + std::to_string(d.polish.max_iterations) + ")\n"
          "  --covariance-scale C  the polish's covariance is C x sigma^2 H^-1 (default " + num(d.polish.covariance_scale) + ")\n"
+         "  --covariance-cell M   plus the clustered covariance over cubes of M m, 0 = off\n"
+         "                        (default " + num(d.polish.covariance_cell_m) + ")\n"
+         "  --covariance-cell-scale K  times K (default " + num(d.polish.covariance_cell_scale) + ")\n"
          "  --coarse-max-points N the coarse search evaluates at most N collapsed points, 0 = all\n"
          "                        (default " + num(d.coarse_max_points) + ")\n"
          "  --refine-collapse F   the refine stage evaluates one point per voxel of F*E\n"
@@ -150,6 +153,10 @@ bool parseAlgorithmOption(const std::vector<std::string>& args, std::size_t& i,
     s.polish.max_iterations = int(value(1)), used = 2;
   } else if (a == "--covariance-scale") {
     s.polish.covariance_scale = value(1), used = 2;
+  } else if (a == "--covariance-cell") {
+    s.polish.covariance_cell_m = value(1), used = 2;
+  } else if (a == "--covariance-cell-scale") {
+    s.polish.covariance_cell_scale = value(1), used = 2;
   } else if (a == "--refine-coarse-weight") {
     s.refine.coarse_weight = value(1), used = 2;
   } else if (a == "--refine-candidates") {

@@ -111,9 +111,10 @@ TEST(AcceptanceGate, RejectsResultsWithAWideCovariance) {
   r.covariance.diagonal() << 1e-6, 1e-6, 1e-6, 1e-8, 1e-8, 1e-8;  // 1 mm
   const Pose6 guess = Pose6::Zero();
   EXPECT_EQ(gate(r, guess, GateSettings{}), GateReason::Accepted);
-  // 4 cm along the diagonal of x and y: each of x and y alone has 2.8 cm, below the default 3.
-  r.covariance(0, 0) = r.covariance(1, 1) = 8e-4;
-  r.covariance(0, 1) = r.covariance(1, 0) = 8e-4 - 1e-6;
+  // 6.9 cm along the diagonal of x and y: each of x and y alone has 4.9 cm, below the
+  // default 5.
+  r.covariance(0, 0) = r.covariance(1, 1) = 2.4e-3;
+  r.covariance(0, 1) = r.covariance(1, 0) = 2.4e-3 - 1e-6;
   EXPECT_EQ(gate(r, guess, GateSettings{}), GateReason::Uncertain);
   GateSettings g;
   g.max_sigma_m = 0.0;

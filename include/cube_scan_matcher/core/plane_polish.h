@@ -63,6 +63,17 @@ struct PolishSettings {
   /// percentile of |error| / sd per axis asked for factors of 1.6-12.5 (hall x the largest);
   /// 12 keeps every axis within 3 sd in ~99 % of the accepted results. In [1, 1e6].
   double covariance_scale = 12.0;
+  /// Plus covariance_cell_scale times the clustered ("sandwich") covariance H^-1 B H^-1,
+  /// B = sum over cubes c of edge covariance_cell_m [m] of g_c g_c^T, g_c the sum of the
+  /// gradient terms w r J of the correspondences in c: model errors shared by a surface's
+  /// points (tangent planes of trunks and poles met from another side) count once per cube,
+  /// not once per point. The plain term alone left 46 % of the forest's accepted results
+  /// beyond 3 sd along x (a 1 cm bias towards the motion) and 14-16 % of the square's; 2 m
+  /// cubes and 25 bring every scene type of the robot worlds except the square to <= 1 %
+  /// (BENCHMARK.md, "A covariance from the residuals' clusters"). covariance_cell_m 0 = off;
+  /// in [0, 100] m; scale in [0, 1e6].
+  double covariance_cell_m = 2.0;
+  double covariance_cell_scale = 25.0;
   /// A correspondence carries information along a translation axis only when its plane's
   /// normal leans towards it by at least this cosine (0.15: 8.6 deg): the small random tilts
   /// of fitted normals are not information. In [0, 1).
