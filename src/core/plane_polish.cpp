@@ -90,8 +90,9 @@ Linearisation linearise(const PlaneMap& map, const PointArray& scan, const Eigen
     J.tail<3>() = rp.cross(plane->normal);
     if (scale) J *= double((*scale)[i]);
     L.H.selfadjointView<Eigen::Upper>().rankUpdate(J, w);
-    if (rows) rows->push_back({plane->normal, w, (w * r) * J, plane->mean.cast<float>()});
-    L.g.noalias() += (w * r) * J;
+    const Vector6 wrJ = (w * r) * J;
+    if (rows) rows->push_back({plane->normal, w, wrJ, plane->mean.cast<float>()});
+    L.g += wrJ;
     L.weight += w;
     L.weighted_r2 += w * r * r;
     ++L.count;

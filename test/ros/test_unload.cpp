@@ -18,36 +18,26 @@ using namespace cube_scan_matcher;
 
 namespace {
 
-/// Loads `type` as `name` into `loader`, lets its callbacks run for `run` seconds, unloads it
-/// and returns the nodelet, which the caller now owns alone (as a manager thread finishing a
-/// callback would). The loader (the manager) stays: in a manager process it outlives every
-/// nodelet, and its queue manager is what the nodelet's queues report new callbacks to.
-boost::shared_ptr<nodelet::Nodelet> loadRunUnload(nodelet::Loader& loader,
-                                                  const boost::shared_ptr<nodelet::Nodelet>& made,
-                                                  const std::string& name,
-                                                  const std::string& type, double run) {
-  EXPECT_TRUE(loader.load(name, type, {}, {}));
-  EXPECT_TRUE(made);
-  ros::WallDuration(run).sleep();
-  EXPECT_TRUE(loader.unload(name));
-  EXPECT_EQ(loader.listLoadedNodelets().size(), 0u);
-  return made;
-}
-
-/// Runs loadRunUnload 20 times, each with a new loader, dropping the last reference to the
-/// nodelet (its destructor: every handle released after the manager let go of its queues)
-/// before the loader goes.
+/// Loads `type` as `name` 20 times, each time into a new nodelet::Loader (the manager's own
+/// class, with its worker threads): lets its callbacks run for 50 ms, unloads it, and then
+/// drops the last reference to the nodelet, which the test now holds alone (as a manager
+/// thread finishing a callback would): its destructor releases every handle after the
+/// manager let go of its queues. The loader stays until then: in a manager process it
+/// outlives every nodelet, and its queue manager is what the nodelet's queues report new
+/// callbacks to.
 void unloadTwentyTimes(const std::string& name, const std::string& type) {
   for (int i = 0; i < 20; ++i) {
-    boost::shared_ptr<nodelet::Nodelet> made;
-    nodelet::Loader loader([&made](const std::string& t) -> boost::shared_ptr<nodelet::Nodelet> {
-      if (t == "ScanMatcherNodelet") made = boost::make_shared<ScanMatcherNodelet>();
-      if (t == "SweepAssemblerNodelet") made = boost::make_shared<SweepAssemblerNodelet>();
-      return made;
+    boost::shared_ptr<nodelet::Nodelet> kept;
+    nodelet::Loader loader([&kept](const std::string& t) -> boost::shared_ptr<nodelet::Nodelet> {
+      if (t == "ScanMatcherNodelet") kept = boost::make_shared<ScanMatcherNodelet>();
+      if (t == "SweepAssemblerNodelet") kept = boost::make_shared<SweepAssemblerNodelet>();
+      return kept;
     });
-    auto kept = loadRunUnload(loader, made, name, type, 0.05);
-    made.reset();
+    EXPECT_TRUE(loader.load(name, type, {}, {}));
     ASSERT_TRUE(kept);
+    ros::WallDuration(0.05).sleep();
+    EXPECT_TRUE(loader.unload(name));
+    EXPECT_EQ(loader.listLoadedNodelets().size(), 0u);
     // A manager thread finishing a callback may still hold a reference for a moment.
     const ros::WallTime deadline = ros::WallTime::now() + ros::WallDuration(2.0);
     while (kept.use_count() > 1 && ros::WallTime::now() < deadline) ros::WallDuration(0.001).sleep();
