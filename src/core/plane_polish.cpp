@@ -22,6 +22,7 @@ void validate(const PolishSettings& s) {
   requireInRange("polish.max_iterations", s.max_iterations, 1, 100);
   requireInRange("polish.tolerance_m", s.tolerance_m, 0.0, 0.1);
   requireInRange("polish.tolerance_rad", s.tolerance_rad, 0.0, 0.01);
+  requireInRange("polish.max_overrelaxation", s.max_overrelaxation, 1.0, 4.0);
   requireInRange("polish.collapse_fraction", s.collapse_fraction, 0.0, 2.0);
   requireInRange("polish.max_shift_m", s.max_shift_m, 1e-4, 10.0);
   requireInRange("polish.max_shift_rad", s.max_shift_rad, 1e-5, 1.0);
@@ -157,6 +158,15 @@ Matrix6 clusteredCovariance(const std::vector<Row>& rows, double cell, const Vec
   return scale.asDiagonal() * inv_s * B * inv_s * scale.asDiagonal();
 }
 
+/// The cosine between two steps in units where 1 rad = rho m (0 when either is zero).
+double cosineScaled(const Vector6& a, const Vector6& b, double rho) {
+  Vector6 scale;
+  scale << 1, 1, 1, rho, rho, rho;
+  const Vector6 sa = scale.asDiagonal() * a, sb = scale.asDiagonal() * b;
+  const double norms = sa.norm() * sb.norm();
+  return norms > 0.0 ? sa.dot(sb) / norms : 0.0;
+}
+
 double radiusOfGyration(const PointArray& points) {
   double sum_r2 = 0.0;
   for (std::size_t i = 0; i < points.size(); ++i) sum_r2 += points.point(i).cast<double>().squaredNorm();
@@ -191,6 +201,8 @@ PolishResult polishOnPlanes(const PlaneMap& map, const PointArray& scan, const P
   bool converged = false;  // the last step was below the tolerances: L still holds there
   PointArray near;
   int it = 0;
+  double stretch = 1.0;  // over-relaxation of the last step
+  Vector6 last_dx = Vector6::Zero();
   for (int round = 0; round < 2 && it < s.max_iterations; ++round) {
     near.clear();
     converged = false;
@@ -201,11 +213,17 @@ PolishResult polishOnPlanes(const PlaneMap& map, const PointArray& scan, const P
       if (it == 0) rho = radiusOfGyration(near);
       const Vector6 dx = step(L, spectrum(L.H, rho), s.weak_ratio);
       if (!dx.allFinite()) break;
-      t += dx.head<3>();
-      const Eigen::Vector3d w = dx.tail<3>();
+      // A step along the last one's direction (on the same points) is stretched; a step that
+      // turns (an overshoot comes back) resets the stretch.
+      stretch = !collect && cosineScaled(dx, last_dx, rho) > 0.8
+                    ? std::min(1.5 * stretch, s.max_overrelaxation)
+                    : 1.0;
+      last_dx = dx;
+      t += stretch * dx.head<3>();
+      const Eigen::Vector3d w = stretch * dx.tail<3>();
       if (w.norm() > 0.0) R = Eigen::AngleAxisd(w.norm(), w.normalized()).toRotationMatrix() * R;
       res.iterations = ++it;
-      if (dx.head<3>().norm() < s.tolerance_m && w.norm() < s.tolerance_rad) {
+      if (dx.head<3>().norm() < s.tolerance_m && dx.tail<3>().norm() < s.tolerance_rad) {
         converged = true;
         break;
       }

@@ -203,6 +203,33 @@ TEST(PlanePolish, ACorridorIsFlaggedAlongItsAxisAndNotMovedAlongIt) {
   EXPECT_GT(r.covariance(0, 0), 100.0 * r.covariance(1, 1));
 }
 
+// Over-relaxation stretches steps that keep their direction: from a start far enough off
+// that the robust weights shorten the plain Gauss-Newton steps, it must land on the plain
+// iteration's pose (the same fixed point) in fewer steps.
+TEST(PlanePolish, OverRelaxationReachesThePlainPoseInFewerSteps) {
+  const PointArray reference = makeScene(false, 2);
+  const Eigen::Isometry3d truth = truthTransform();
+  const PointArray scan = transformed(makeScene(false, 3), truth.inverse());
+  const PlaneMap map(reference, 0.25, 6, 0.1);
+  PolishSettings plain;
+  plain.max_overrelaxation = 1.0;
+  plain.max_iterations = 100;
+  PolishSettings relaxed = plain;
+  relaxed.max_overrelaxation = 2.0;
+  Pose6 start = isometryToPose(truth);
+  start.head<3>() += Eigen::Vector3d(0.10, -0.06, 0.03);
+  start.tail<3>() += Eigen::Vector3d(0.002, -0.002, 0.008);
+  const PolishResult a = polishOnPlanes(map, scan, start, plain);
+  const PolishResult b = polishOnPlanes(map, scan, start, relaxed);
+  ASSERT_TRUE(a.applied) << a.reason;
+  ASSERT_TRUE(b.applied) << b.reason;
+  const Eigen::Isometry3d ta = poseToIsometry(a.pose), tb = poseToIsometry(b.pose);
+  EXPECT_LT((ta.translation() - tb.translation()).norm(), 1e-3);
+  EXPECT_LT(rad2deg(Eigen::AngleAxisd(ta.linear() * tb.linear().transpose()).angle()), 0.01);
+  EXPECT_LT((tb.translation() - truth.translation()).norm(), 0.002);
+  EXPECT_LT(b.iterations, a.iterations);
+}
+
 TEST(PlanePolish, GivesUpWithoutPlanesAndKeepsThePose) {
   const PointArray reference = makeScene(false, 2);
   const PlaneMap map(reference, 0.25, 6, 0.1);
@@ -227,6 +254,14 @@ TEST(PlanePolish, SettingsAreValidated) {
   s = PolishSettings{};
   s.covariance_scale = 0.5;
   EXPECT_THROW(validate(s), std::invalid_argument);
+  s = PolishSettings{};
+  s.max_overrelaxation = 0.5;  // a shrunk step
+  EXPECT_THROW(validate(s), std::invalid_argument);
+  s.max_overrelaxation = 5.0;
+  EXPECT_THROW(validate(s), std::invalid_argument);
+  s.max_overrelaxation = 1.0;
+  EXPECT_NO_THROW(validate(s));
+  s.covariance_scale = 0.5;
   s.enabled = false;  // not checked when off
   EXPECT_NO_THROW(validate(s));
 }
