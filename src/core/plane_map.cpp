@@ -109,6 +109,17 @@ const LocalPlane* PlaneMap::planeAt(const Eigen::Vector3d& q) const {
   return fit_[index] == Fit::Plane ? &planes_[index] : nullptr;
 }
 
+const LocalPlane* PlaneMap::planeOfVoxel(std::int64_t ix, std::int64_t iy, std::int64_t iz) const {
+  if (stats_.empty() || ix < 0 || iy < 0 || iz < 0 || ix > kMaxIndex || iy > kMaxIndex ||
+      iz > kMaxIndex) {
+    return nullptr;
+  }
+  const std::uint32_t index = keys_->find(detail::packVoxel(ix, iy, iz));
+  if (index == detail::KeyIndex::kNone) return nullptr;
+  if (fit_[index] == Fit::Unknown) fit(index, ix, iy, iz);
+  return fit_[index] == Fit::Plane ? &planes_[index] : nullptr;
+}
+
 std::size_t PlaneMap::memoryBytes() const {
   return (keys_ ? keys_->memoryBytes() : 0) + stats_.capacity() * sizeof(Stats) +
          voxel_of_.capacity() * sizeof(std::uint32_t) +

@@ -1,6 +1,7 @@
 #include "cube_scan_matcher/core/plane_polish.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <vector>
 
@@ -64,9 +65,34 @@ struct Row {
   Eigen::Vector3f m;
 };
 
-/// With `near`, also collects the scan points that found a plane (the only ones the later
-/// iterations need to look at: the pose moves by millimetres); with `rows`, every
-/// correspondence's normal and weight.
+/// Adds the correspondence of q = rp + t with `plane`, its robust weight times `beta`, and its
+/// Jacobian times `jscale`; false (nothing added) when q is more than max_r from the plane.
+inline bool addCorrespondence(Linearisation& L, const LocalPlane& plane, const Eigen::Vector3d& rp,
+                              const Eigen::Vector3d& q, double beta, double jscale, double k2,
+                              double max_r, std::vector<Row>* rows) {
+  const double r = plane.normal.dot(q - plane.mean);
+  if (std::abs(r) > max_r) return false;
+  const double s = k2 / (k2 + r * r);
+  const double w = beta * s * s;
+  Vector6 J;
+  J.head<3>() = plane.normal;
+  J.tail<3>() = rp.cross(plane.normal);
+  if (jscale != 1.0) J *= jscale;
+  for (int a = 0; a < 6; ++a) {  // the upper triangle of H += w J J^T
+    const double wa = w * J[a];
+    for (int b = a; b < 6; ++b) L.H(a, b) += wa * J[b];
+  }
+  const Vector6 wrJ = (w * r) * J;
+  if (rows) rows->push_back({plane.normal, w, wrJ, plane.mean.cast<float>()});
+  L.g += wrJ;
+  L.weight += w;
+  L.weighted_r2 += w * r * r;
+  return true;
+}
+
+/// One plane per scan point: its own voxel's. With `near`, also collects the scan points that
+/// found a plane (the only ones the later iterations need to look at: the pose moves by
+/// millimetres); with `rows`, every correspondence.
 /// With `scale`, each point's Jacobian is multiplied by scale[i] (the sweep polish).
 Linearisation linearise(const PlaneMap& map, const PointArray& scan, const Eigen::Matrix3d& R,
                         const Eigen::Vector3d& t, double kernel, PointArray* near = nullptr,
@@ -82,21 +108,75 @@ Linearisation linearise(const PlaneMap& map, const PointArray& scan, const Eigen
     if (!plane) continue;
     if (near) near->push_back(scan.x[i], scan.y[i], scan.z[i]);
     if (near_index) near_index->push_back(i);
-    const double r = plane->normal.dot(q - plane->mean);
-    if (std::abs(r) > max_r) continue;
-    const double s = k2 / (k2 + r * r);
-    const double w = s * s;
-    Vector6 J;
-    J.head<3>() = plane->normal;
-    J.tail<3>() = rp.cross(plane->normal);
-    if (scale) J *= double((*scale)[i]);
-    L.H.selfadjointView<Eigen::Upper>().rankUpdate(J, w);
-    const Vector6 wrJ = (w * r) * J;
-    if (rows) rows->push_back({plane->normal, w, wrJ, plane->mean.cast<float>()});
-    L.g += wrJ;
-    L.weight += w;
-    L.weighted_r2 += w * r * r;
-    ++L.count;
+    const double jscale = scale ? double((*scale)[i]) : 1.0;
+    if (addCorrespondence(L, *plane, rp, q, 1.0, jscale, k2, max_r, rows)) ++L.count;
+  }
+  L.H.triangularView<Eigen::StrictlyLower>() = L.H.transpose();
+  return L;
+}
+
+/// The 8 voxels whose centres surround a point: the lowest one (PlaneMap::planeOfVoxel
+/// indices, packed) and their planes, nullptr where a voxel has none.
+struct Corners {
+  std::uint64_t base = ~std::uint64_t{0};
+  std::array<const LocalPlane*, 8> planes{};
+};
+
+/// Trilinear correspondences: each scan point is paired with the planes of the 8 voxels whose
+/// centres surround q, each weighted by q's trilinear weight for that centre (they sum to 1).
+/// The weights vary continuously with the pose, so the objective has no steps where a point
+/// crosses a voxel face: a polish started a centimetre apart ends on the same pose.
+/// `corners[i]` caches point i's planes; they are looked up again only when q moves into
+/// another set of 8 voxels. With `near`, collects the points that have a plane among their 8
+/// (and their corners, in `near_corners`).
+Linearisation lineariseTrilinear(const PlaneMap& map, const PointArray& scan,
+                                 const Eigen::Matrix3d& R, const Eigen::Vector3d& t,
+                                 double kernel, std::vector<Corners>& corners,
+                                 PointArray* near = nullptr,
+                                 std::vector<Corners>* near_corners = nullptr,
+                                 std::vector<Row>* rows = nullptr) {
+  Linearisation L;
+  const double k2 = kernel * kernel;
+  const double max_r = map.voxel();
+  const double inv = map.inverseVoxel();
+  corners.resize(scan.size());
+  for (std::size_t i = 0; i < scan.size(); ++i) {
+    const Eigen::Vector3d rp = R * scan.point(i).cast<double>();
+    const Eigen::Vector3d q = rp + t;
+    // Voxel k's centre is at (k + 1/2) / inv: u = q inv - 1/2 has the lower centre at floor(u).
+    std::int64_t b[3];
+    double f[3];
+    for (int k = 0; k < 3; ++k) {
+      const double u = q[k] * inv - 0.5;
+      const double lower = std::floor(u);
+      f[k] = u - lower;
+      b[k] = std::int64_t(std::clamp(lower, -double(1 << 20), double(1 << 20))) + (1 << 20);
+    }
+    Corners& c = corners[i];
+    const std::uint64_t base = detail::packVoxel(b[0], b[1], b[2]);
+    if (c.base != base) {
+      c.base = base;
+      for (int k = 0; k < 8; ++k) {
+        c.planes[std::size_t(k)] = map.planeOfVoxel(b[0] + (k & 1), b[1] + ((k >> 1) & 1),
+                                                    b[2] + ((k >> 2) & 1));
+      }
+    }
+    bool any_plane = false, any = false;
+    for (int k = 0; k < 8; ++k) {
+      const LocalPlane* plane = c.planes[std::size_t(k)];
+      if (!plane) continue;
+      any_plane = true;
+      const double beta = ((k & 1) ? f[0] : 1.0 - f[0]) * (((k >> 1) & 1) ? f[1] : 1.0 - f[1]) *
+                          (((k >> 2) & 1) ? f[2] : 1.0 - f[2]);
+      if (beta > 0.0 && addCorrespondence(L, *plane, rp, q, beta, 1.0, k2, max_r, rows)) {
+        any = true;
+      }
+    }
+    if (any_plane && near) {
+      near->push_back(scan.x[i], scan.y[i], scan.z[i]);
+      near_corners->push_back(c);
+    }
+    if (any) ++L.count;
   }
   L.H.triangularView<Eigen::StrictlyLower>() = L.H.transpose();
   return L;
@@ -199,16 +279,30 @@ PolishResult polishOnPlanes(const PlaneMap& map, const PointArray& scan, const P
   // them again at the first round's result, so the final set does not depend on the start.
   Linearisation L;
   bool converged = false;  // the last step was below the tolerances: L still holds there
-  PointArray near;
   int it = 0;
+  // Reused from call to call: a fresh correspondence list of a few thousand rows would be
+  // faulted in page by page at every registration (~10 us per page fault on a VM).
+  thread_local PointArray near;
+  thread_local std::vector<Corners> all_corners, near_corners;
+  thread_local std::vector<Row> rows;
+  auto lineariseAt = [&](const PointArray& points, bool collect, std::vector<Row>* out_rows) {
+    if (!s.trilinear) {
+      return linearise(map, points, R, t, s.kernel, collect ? &near : nullptr, out_rows);
+    }
+    if (!collect) return lineariseTrilinear(map, points, R, t, s.kernel, near_corners, nullptr, nullptr, out_rows);
+    // The collecting passes run over the same points: the first round's corners stay valid
+    // as a cache for the second's (the pose has moved by centimetres at most).
+    if (all_corners.size() != points.size() || it == 0) all_corners.assign(points.size(), Corners());
+    return lineariseTrilinear(map, points, R, t, s.kernel, all_corners, &near, &near_corners, out_rows);
+  };
   double stretch = 1.0;  // over-relaxation of the last step
   Vector6 last_dx = Vector6::Zero();
   for (int round = 0; round < 2 && it < s.max_iterations; ++round) {
     near.clear();
+    near_corners.clear();
     converged = false;
     for (bool collect = true; it < s.max_iterations; collect = false) {
-      L = collect ? linearise(map, scan, R, t, s.kernel, &near)
-                  : linearise(map, near, R, t, s.kernel);
+      L = collect ? lineariseAt(scan, true, nullptr) : lineariseAt(near, false, nullptr);
       if (L.count < s.min_correspondences) break;
       if (it == 0) rho = radiusOfGyration(near);
       const Vector6 dx = step(L, spectrum(L.H, rho), s.weak_ratio);
@@ -230,7 +324,10 @@ PolishResult polishOnPlanes(const PlaneMap& map, const PointArray& scan, const P
     }
     if (!converged) break;
   }
-  std::vector<Row> rows;
+  // The covariance and the weak axes from each point's own voxel's plane (with the trilinear
+  // pairs, a floor point near a wall would also meet the wall's plane: a residual of the
+  // corner's geometry, not of the pose, which would widen the covariance).
+  rows.clear();
   L = linearise(map, near.empty() ? scan : near, R, t, s.kernel, nullptr, &rows);
   res.correspondences = L.count;
   if (L.count < s.min_correspondences || L.weight <= 6.0) {

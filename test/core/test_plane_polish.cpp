@@ -3,9 +3,12 @@
 // known transform, the covariance's shape, and the weak direction of a corridor.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <random>
 #include <stdexcept>
+#include <vector>
 
 #include <Eigen/Eigenvalues>
 
@@ -212,6 +215,7 @@ TEST(PlanePolish, OverRelaxationReachesThePlainPoseInFewerSteps) {
   const PointArray scan = transformed(makeScene(false, 3), truth.inverse());
   const PlaneMap map(reference, 0.25, 6, 0.1);
   PolishSettings plain;
+  plain.trilinear = false;  // the piecewise objective, where the plain steps fall short
   plain.max_overrelaxation = 1.0;
   plain.max_iterations = 100;
   PolishSettings relaxed = plain;
@@ -228,6 +232,48 @@ TEST(PlanePolish, OverRelaxationReachesThePlainPoseInFewerSteps) {
   EXPECT_LT(rad2deg(Eigen::AngleAxisd(ta.linear() * tb.linear().transpose()).angle()), 0.01);
   EXPECT_LT((tb.translation() - truth.translation()).norm(), 0.002);
   EXPECT_LT(b.iterations, a.iterations);
+}
+
+// Trilinear correspondences make the objective continuous in the pose: polishes started up to
+// 3 cm / 0.3 deg apart must end on one pose; with one plane per point (each point's own voxel)
+// they end where the steps of the piecewise objective leave them.
+TEST(PlanePolish, TrilinearCorrespondencesEndOnOnePoseFromEveryStart) {
+  const PointArray reference = makeScene(false, 2);
+  const Eigen::Isometry3d truth = truthTransform();
+  const PointArray scan = transformed(makeScene(false, 3), truth.inverse());
+  const PlaneMap map(reference, 0.25, 6, 0.1);
+  auto spread = [&](bool trilinear) {
+    PolishSettings s;
+    s.trilinear = trilinear;
+    std::mt19937_64 rng(7);
+    std::uniform_real_distribution<double> u(-1.0, 1.0);
+    std::vector<Eigen::Isometry3d> ends;
+    for (int k = 0; k < 12; ++k) {
+      Pose6 start = isometryToPose(truth);
+      for (int i = 0; i < 3; ++i) start[i] += 0.03 * u(rng);
+      for (int i = 3; i < 6; ++i) start[i] += deg2rad(0.3) * u(rng);
+      const PolishResult r = polishOnPlanes(map, scan, start, s);
+      EXPECT_TRUE(r.applied) << r.reason;
+      ends.push_back(poseToIsometry(r.pose));
+    }
+    double max_t = 0.0, max_deg = 0.0;
+    for (const Eigen::Isometry3d& a : ends) {
+      for (const Eigen::Isometry3d& b : ends) {
+        max_t = std::max(max_t, (a.translation() - b.translation()).norm());
+        max_deg = std::max(max_deg, rad2deg(Eigen::AngleAxisd(a.linear() * b.linear().transpose()).angle()));
+      }
+    }
+    return std::make_pair(max_t, max_deg);
+  };
+  const auto [t3, deg3] = spread(true);
+  const auto [t1, deg1] = spread(false);
+  EXPECT_LT(t3, 3e-4);
+  EXPECT_LT(deg3, 0.003);
+  EXPECT_GT(t1, t3);
+  RecordProperty("spread_trilinear_mm", std::to_string(t3 * 1e3));
+  RecordProperty("spread_own_voxel_mm", std::to_string(t1 * 1e3));
+  std::printf("polish end spread over 12 starts: trilinear %.3f mm / %.4f deg, own voxel %.3f mm / %.4f deg\n",
+              t3 * 1e3, deg3, t1 * 1e3, deg1);
 }
 
 TEST(PlanePolish, GivesUpWithoutPlanesAndKeepsThePose) {

@@ -51,6 +51,9 @@ class PlaneMap {
   /// The plane of the voxel holding q, or nullptr (no reference point there, too few, not flat).
   /// Fits and caches it on first use: not safe to call from two threads at once.
   const LocalPlane* planeAt(const Eigen::Vector3d& q) const;
+  /// The plane of voxel (ix, iy, iz) in voxelIndex() units (offset by 2^20), or nullptr.
+  const LocalPlane* planeOfVoxel(std::int64_t ix, std::int64_t iy, std::int64_t iz) const;
+  float inverseVoxel() const { return inv_; }
 
   double voxel() const { return voxel_; }
   /// Occupied voxels (0 for an empty map).
