@@ -99,14 +99,8 @@ void PlaneMap::fit(std::size_t index, std::int64_t ix, std::int64_t iy, std::int
 }
 
 const LocalPlane* PlaneMap::planeAt(const Eigen::Vector3d& q) const {
-  if (stats_.empty()) return nullptr;
-  const std::int64_t ix = detail::voxelIndex(float(q.x()), inv_);
-  const std::int64_t iy = detail::voxelIndex(float(q.y()), inv_);
-  const std::int64_t iz = detail::voxelIndex(float(q.z()), inv_);
-  const std::uint32_t index = keys_->find(detail::packVoxel(ix, iy, iz));
-  if (index == detail::KeyIndex::kNone) return nullptr;
-  if (fit_[index] == Fit::Unknown) fit(index, ix, iy, iz);
-  return fit_[index] == Fit::Plane ? &planes_[index] : nullptr;
+  return planeOfVoxel(detail::voxelIndex(float(q.x()), inv_), detail::voxelIndex(float(q.y()), inv_),
+                      detail::voxelIndex(float(q.z()), inv_));
 }
 
 const LocalPlane* PlaneMap::planeOfVoxel(std::int64_t ix, std::int64_t iy, std::int64_t iz) const {

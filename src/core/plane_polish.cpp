@@ -45,8 +45,9 @@ using Matrix6 = Eigen::Matrix<double, 6, 6>;
 using Vector6 = Eigen::Matrix<double, 6, 1>;
 
 /// The least-squares problem linearised at (R, t): for each scan point p with q = R p + t and
-/// a plane (n, m) within one voxel, residual r = n . (q - m), Jacobian [n, (R p) x n] for the
-/// perturbation t' = t + dt, R' = exp(dtheta) R; Geman-McClure weights.
+/// each of its planes (n, m) (its own voxel's, or the 8 around it), residual r = n . (q - m),
+/// Jacobian [n, (R p) x n] for the perturbation t' = t + dt, R' = exp(dtheta) R; Geman-McClure
+/// weights. `count`: the scan points with at least one correspondence.
 struct Linearisation {
   Matrix6 H = Matrix6::Zero();
   Vector6 g = Vector6::Zero();
@@ -133,8 +134,7 @@ Linearisation lineariseTrilinear(const PlaneMap& map, const PointArray& scan,
                                  const Eigen::Matrix3d& R, const Eigen::Vector3d& t,
                                  double kernel, std::vector<Corners>& corners,
                                  PointArray* near = nullptr,
-                                 std::vector<Corners>* near_corners = nullptr,
-                                 std::vector<Row>* rows = nullptr) {
+                                 std::vector<Corners>* near_corners = nullptr) {
   Linearisation L;
   const double k2 = kernel * kernel;
   const double max_r = map.voxel();
@@ -168,7 +168,7 @@ Linearisation lineariseTrilinear(const PlaneMap& map, const PointArray& scan,
       any_plane = true;
       const double beta = ((k & 1) ? f[0] : 1.0 - f[0]) * (((k >> 1) & 1) ? f[1] : 1.0 - f[1]) *
                           (((k >> 2) & 1) ? f[2] : 1.0 - f[2]);
-      if (beta > 0.0 && addCorrespondence(L, *plane, rp, q, beta, 1.0, k2, max_r, rows)) {
+      if (beta > 0.0 && addCorrespondence(L, *plane, rp, q, beta, 1.0, k2, max_r, nullptr)) {
         any = true;
       }
     }
@@ -285,15 +285,14 @@ PolishResult polishOnPlanes(const PlaneMap& map, const PointArray& scan, const P
   thread_local PointArray near;
   thread_local std::vector<Corners> all_corners, near_corners;
   thread_local std::vector<Row> rows;
-  auto lineariseAt = [&](const PointArray& points, bool collect, std::vector<Row>* out_rows) {
-    if (!s.trilinear) {
-      return linearise(map, points, R, t, s.kernel, collect ? &near : nullptr, out_rows);
-    }
-    if (!collect) return lineariseTrilinear(map, points, R, t, s.kernel, near_corners, nullptr, nullptr, out_rows);
-    // The collecting passes run over the same points: the first round's corners stay valid
-    // as a cache for the second's (the pose has moved by centimetres at most).
-    if (all_corners.size() != points.size() || it == 0) all_corners.assign(points.size(), Corners());
-    return lineariseTrilinear(map, points, R, t, s.kernel, all_corners, &near, &near_corners, out_rows);
+  // A collecting pass runs over every scan point and fills `near`; the others over `near`.
+  auto lineariseAt = [&](bool collect) {
+    if (!s.trilinear) return linearise(map, collect ? scan : near, R, t, s.kernel, collect ? &near : nullptr);
+    if (!collect) return lineariseTrilinear(map, near, R, t, s.kernel, near_corners);
+    // The first round's corners stay valid as a cache for the second round's collecting pass
+    // (the pose has moved by centimetres at most).
+    if (it == 0) all_corners.assign(scan.size(), Corners());
+    return lineariseTrilinear(map, scan, R, t, s.kernel, all_corners, &near, &near_corners);
   };
   double stretch = 1.0;  // over-relaxation of the last step
   Vector6 last_dx = Vector6::Zero();
@@ -302,7 +301,7 @@ PolishResult polishOnPlanes(const PlaneMap& map, const PointArray& scan, const P
     near_corners.clear();
     converged = false;
     for (bool collect = true; it < s.max_iterations; collect = false) {
-      L = collect ? lineariseAt(scan, true, nullptr) : lineariseAt(near, false, nullptr);
+      L = lineariseAt(collect);
       if (L.count < s.min_correspondences) break;
       if (it == 0) rho = radiusOfGyration(near);
       const Vector6 dx = step(L, spectrum(L.H, rho), s.weak_ratio);
