@@ -24,6 +24,7 @@ void validate(const PolishSettings& s) {
   requireInRange("polish.tolerance_m", s.tolerance_m, 0.0, 0.1);
   requireInRange("polish.tolerance_rad", s.tolerance_rad, 0.0, 0.01);
   requireInRange("polish.max_overrelaxation", s.max_overrelaxation, 1.0, 4.0);
+  requireInRange("polish.trilinear_sharpness", s.trilinear_sharpness, 1.0, 8.0);
   requireInRange("polish.collapse_fraction", s.collapse_fraction, 0.0, 2.0);
   requireInRange("polish.max_shift_m", s.max_shift_m, 1e-4, 10.0);
   requireInRange("polish.max_shift_rad", s.max_shift_rad, 1e-5, 1.0);
@@ -124,7 +125,8 @@ struct Corners {
 };
 
 /// Trilinear correspondences: each scan point is paired with the planes of the 8 voxels whose
-/// centres surround q, each weighted by q's trilinear weight for that centre (they sum to 1).
+/// centres surround q, each weighted by q's trilinear weight for that centre (they sum to 1),
+/// sharpened per axis by `sharpness` p: (1-f)^p / ((1-f)^p + f^p) for the lower centre.
 /// The weights vary continuously with the pose, so the objective has no steps where a point
 /// crosses a voxel face: a polish started a centimetre apart ends on the same pose.
 /// `corners[i]` caches point i's planes; they are looked up again only when q moves into
@@ -132,7 +134,7 @@ struct Corners {
 /// (and their corners, in `near_corners`).
 Linearisation lineariseTrilinear(const PlaneMap& map, const PointArray& scan,
                                  const Eigen::Matrix3d& R, const Eigen::Vector3d& t,
-                                 double kernel, std::vector<Corners>& corners,
+                                 double kernel, double sharpness, std::vector<Corners>& corners,
                                  PointArray* near = nullptr,
                                  std::vector<Corners>* near_corners = nullptr) {
   Linearisation L;
@@ -145,11 +147,18 @@ Linearisation lineariseTrilinear(const PlaneMap& map, const PointArray& scan,
     const Eigen::Vector3d q = rp + t;
     // Voxel k's centre is at (k + 1/2) / inv: u = q inv - 1/2 has the lower centre at floor(u).
     std::int64_t b[3];
-    double f[3];
+    double g[3][2];  // per axis: the weights of the lower and the upper centre
     for (int k = 0; k < 3; ++k) {
       const double u = q[k] * inv - 0.5;
       const double lower = std::floor(u);
-      f[k] = u - lower;
+      const double f = u - lower;
+      if (sharpness == 1.0) {
+        g[k][0] = 1.0 - f, g[k][1] = f;
+      } else {
+        const double lo = sharpness == 2.0 ? (1.0 - f) * (1.0 - f) : std::pow(1.0 - f, sharpness);
+        const double hi = sharpness == 2.0 ? f * f : std::pow(f, sharpness);
+        g[k][0] = lo / (lo + hi), g[k][1] = hi / (lo + hi);
+      }
       b[k] = std::int64_t(std::clamp(lower, -double(1 << 20), double(1 << 20))) + (1 << 20);
     }
     Corners& c = corners[i];
@@ -166,8 +175,7 @@ Linearisation lineariseTrilinear(const PlaneMap& map, const PointArray& scan,
       const LocalPlane* plane = c.planes[std::size_t(k)];
       if (!plane) continue;
       any_plane = true;
-      const double beta = ((k & 1) ? f[0] : 1.0 - f[0]) * (((k >> 1) & 1) ? f[1] : 1.0 - f[1]) *
-                          (((k >> 2) & 1) ? f[2] : 1.0 - f[2]);
+      const double beta = g[0][k & 1] * g[1][(k >> 1) & 1] * g[2][(k >> 2) & 1];
       if (beta > 0.0 && addCorrespondence(L, *plane, rp, q, beta, 1.0, k2, max_r, nullptr)) {
         any = true;
       }
@@ -288,11 +296,12 @@ PolishResult polishOnPlanes(const PlaneMap& map, const PointArray& scan, const P
   // A collecting pass runs over every scan point and fills `near`; the others over `near`.
   auto lineariseAt = [&](bool collect) {
     if (!s.trilinear) return linearise(map, collect ? scan : near, R, t, s.kernel, collect ? &near : nullptr);
-    if (!collect) return lineariseTrilinear(map, near, R, t, s.kernel, near_corners);
+    if (!collect) return lineariseTrilinear(map, near, R, t, s.kernel, s.trilinear_sharpness, near_corners);
     // The first round's corners stay valid as a cache for the second round's collecting pass
     // (the pose has moved by centimetres at most).
     if (it == 0) all_corners.assign(scan.size(), Corners());
-    return lineariseTrilinear(map, scan, R, t, s.kernel, all_corners, &near, &near_corners);
+    return lineariseTrilinear(map, scan, R, t, s.kernel, s.trilinear_sharpness, all_corners,
+                              &near, &near_corners);
   };
   double stretch = 1.0;  // over-relaxation of the last step
   Vector6 last_dx = Vector6::Zero();

@@ -69,6 +69,8 @@ std::string algorithmOptionsHelp() {
          "  --polish-iterations N Gauss-Newton steps of the polish (default " + std::to_string(d.polish.max_iterations) + ")\n"
          "  --polish-trilinear B  1: each point meets the planes of the 8 voxels around it,\n"
          "                        trilinearly weighted; 0: its own voxel's plane (default " + std::to_string(int(d.polish.trilinear)) + ")\n"
+         "  --polish-sharpness P  trilinear weights sharpened to (1-f)^P, f^P per axis,\n"
+         "                        normalised; 1 = plain trilinear (default " + num(d.polish.trilinear_sharpness) + ")\n"
          "  --polish-overrelax F  a polish step along the last one's direction is stretched\n"
          "                        up to F times, 1 = plain Gauss-Newton (default " + num(d.polish.max_overrelaxation) + ")\n"
          "  --covariance-scale C  the polish's covariance is C x sigma^2 H^-1 (default " + num(d.polish.covariance_scale) + ")\n"
@@ -157,6 +159,8 @@ bool parseAlgorithmOption(const std::vector<std::string>& args, std::size_t& i,
     s.polish.max_iterations = int(value(1)), used = 2;
   } else if (a == "--polish-trilinear") {
     s.polish.trilinear = value(1) != 0.0, used = 2;
+  } else if (a == "--polish-sharpness") {
+    s.polish.trilinear_sharpness = value(1), used = 2;
   } else if (a == "--polish-overrelax") {
     s.polish.max_overrelaxation = value(1), used = 2;
   } else if (a == "--covariance-scale") {
