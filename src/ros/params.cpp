@@ -56,6 +56,7 @@ void configToSettings(const ScanMatcherConfig& c, OnlineMatcherSettings& m) {
   r.polish.covariance_scale = c.covariance_scale;
   r.polish.covariance_cell_m = c.covariance_cell;
   r.polish.covariance_cell_scale = c.covariance_cell_scale;
+  r.polish.covariance_jackknife_cap = c.covariance_jackknife;
   m.gate.min_overlap = c.min_overlap;
   m.gate.min_j_gain = c.min_j_gain;
   m.gate.max_correction_m = c.max_correction_translation;
@@ -146,6 +147,7 @@ ScanMatcherConfig toConfig(const NodeParams& p) {
   c.covariance_scale = r.polish.covariance_scale;
   c.covariance_cell = r.polish.covariance_cell_m;
   c.covariance_cell_scale = r.polish.covariance_cell_scale;
+  c.covariance_jackknife = r.polish.covariance_jackknife_cap;
   c.min_overlap = p.matcher.gate.min_overlap;
   c.min_j_gain = p.matcher.gate.min_j_gain;
   c.max_correction_translation = p.matcher.gate.max_correction_m;

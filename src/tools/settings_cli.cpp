@@ -77,6 +77,8 @@ std::string algorithmOptionsHelp() {
          "  --covariance-cell M   plus the clustered covariance over cubes of M m, 0 = off\n"
          "                        (default " + num(d.polish.covariance_cell_m) + ")\n"
          "  --covariance-cell-scale K  times K (default " + num(d.polish.covariance_cell_scale) + ")\n"
+         "  --covariance-jackknife C  each cube's clustered term left out (jackknife), widened\n"
+         "                        at most C times in sd; 0 = off (default " + num(d.polish.covariance_jackknife_cap) + ")\n"
          "  --coarse-max-points N the coarse search evaluates at most N collapsed points, 0 = all\n"
          "                        (default " + num(d.coarse_max_points) + ")\n"
          "  --refine-collapse F   the refine stage evaluates one point per voxel of F*E\n"
@@ -169,6 +171,8 @@ bool parseAlgorithmOption(const std::vector<std::string>& args, std::size_t& i,
     s.polish.covariance_cell_m = value(1), used = 2;
   } else if (a == "--covariance-cell-scale") {
     s.polish.covariance_cell_scale = value(1), used = 2;
+  } else if (a == "--covariance-jackknife") {
+    s.polish.covariance_jackknife_cap = value(1), used = 2;
   } else if (a == "--refine-coarse-weight") {
     s.refine.coarse_weight = value(1), used = 2;
   } else if (a == "--refine-candidates") {

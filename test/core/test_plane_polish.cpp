@@ -188,6 +188,61 @@ TEST(PlanePolish, ErrorsSharedByAPatchWidenTheClusteredCovariance) {
   EXPECT_THROW(validate(bad), std::invalid_argument);
 }
 
+// The jackknife (covariance_jackknife_cap): a corridor along x whose x only two small end
+// tiles fix, each shifted along x by its own error. The fit splits the difference, so each
+// tile's residual is half its error and the plain clustered term sees half the spread (a
+// quarter of the variance); left out in turn, each tile's share is its whole error. Along y
+// and z, which long walls and the floor fix across many cubes, the two agree.
+TEST(PlanePolish, TheJackknifeWidensWhatFewCubesFix) {
+  const Eigen::Vector3d X = Eigen::Vector3d::UnitX(), Y = Eigen::Vector3d::UnitY(),
+                        Z = Eigen::Vector3d::UnitZ();
+  const Eigen::Vector3d off_grid(0.37, 0.29, 0.43);  // surfaces off the 1 m cubes' faces
+  auto corridor = [&](double shift_a, double shift_b, std::uint64_t seed) {
+    std::mt19937_64 rng(seed);
+    PointArray p;
+    addRectangle(p, off_grid + Eigen::Vector3d(-10, -4, 0), X, Y, 20, 8, 0.1, 0.003, rng);
+    addRectangle(p, off_grid + Eigen::Vector3d(-10, -4, 0), X, Z, 20, 3, 0.1, 0.003, rng);
+    addRectangle(p, off_grid + Eigen::Vector3d(-10, 4, 0), X, Z, 20, 3, 0.1, 0.003, rng);
+    // The two tiles (0.8 m, inside one 1 m cube each), facing along x.
+    addRectangle(p, off_grid + Eigen::Vector3d(-6 + shift_a, -1.2, 0.6), Y, Z, 0.8, 0.8, 0.05, 0.003, rng);
+    addRectangle(p, off_grid + Eigen::Vector3d(6 + shift_b, 0.75, 0.6), Y, Z, 0.8, 0.8, 0.05, 0.003, rng);
+    return p;
+  };
+  const PlaneMap map(corridor(0.0, 0.0, 2), 0.25, 6, 0.1);
+  const PointArray scan = corridor(0.02, -0.01, 3);
+  PolishSettings plain;
+  plain.covariance_cell_m = 1.0;
+  plain.covariance_cell_scale = 1.0;
+  plain.covariance_scale = 1.0;
+  plain.covariance_jackknife_cap = 0.0;
+  PolishSettings jackknife = plain;
+  jackknife.covariance_jackknife_cap = 100.0;
+  const PolishResult a = polishOnPlanes(map, scan, Pose6::Zero(), plain);
+  const PolishResult b = polishOnPlanes(map, scan, Pose6::Zero(), jackknife);
+  ASSERT_TRUE(a.applied) << a.reason;
+  ASSERT_TRUE(b.applied) << b.reason;
+  EXPECT_EQ(a.pose, b.pose);  // the covariance only
+  EXPECT_NEAR(a.pose[0], -0.005, 0.002);  // back by the tiles' mean shift
+  const double ratio_x = std::sqrt(b.covariance(0, 0) / a.covariance(0, 0));
+  EXPECT_GT(ratio_x, 1.7);  // 2 for the clustered term alone
+  EXPECT_LT(ratio_x, 2.2);
+  for (int axis : {1, 2}) {
+    EXPECT_LT(std::sqrt(b.covariance(axis, axis) / a.covariance(axis, axis)), 1.15) << "axis " << axis;
+  }
+  // A cap of 1 or less is off; a cap widens a cube's share at most that many times in sd.
+  PolishSettings off = jackknife;
+  off.covariance_jackknife_cap = 1.0;
+  EXPECT_EQ(polishOnPlanes(map, scan, Pose6::Zero(), off).covariance, a.covariance);
+  PolishSettings capped = jackknife;
+  capped.covariance_jackknife_cap = 1.5;
+  const double capped_x = polishOnPlanes(map, scan, Pose6::Zero(), capped).covariance(0, 0);
+  EXPECT_GT(capped_x, a.covariance(0, 0));
+  EXPECT_LT(capped_x, b.covariance(0, 0));
+  std::printf("x sd: plain clustered %.2f mm, jackknife %.2f mm, capped at 1.5 %.2f mm\n",
+              1e3 * std::sqrt(a.covariance(0, 0)), 1e3 * std::sqrt(b.covariance(0, 0)),
+              1e3 * std::sqrt(capped_x));
+}
+
 TEST(PlanePolish, ACorridorIsFlaggedAlongItsAxisAndNotMovedAlongIt) {
   const PointArray reference = makeScene(true, 2);
   const Eigen::Isometry3d truth = truthTransform();
@@ -317,6 +372,12 @@ TEST(PlanePolish, SettingsAreValidated) {
   s.trilinear_sharpness = 9.0;
   EXPECT_THROW(validate(s), std::invalid_argument);
   s.trilinear_sharpness = 1.0;
+  EXPECT_NO_THROW(validate(s));
+  s.covariance_jackknife_cap = -1.0;
+  EXPECT_THROW(validate(s), std::invalid_argument);
+  s.covariance_jackknife_cap = std::nan("");
+  EXPECT_THROW(validate(s), std::invalid_argument);
+  s.covariance_jackknife_cap = 10.0;
   EXPECT_NO_THROW(validate(s));
   s.covariance_scale = 0.5;
   s.enabled = false;  // not checked when off

@@ -94,6 +94,14 @@ struct PolishSettings {
   /// in [0, 100] m; scale in [0, 1e6].
   double covariance_cell_m = 2.0;
   double covariance_cell_scale = 25.0;
+  /// > 1: each cube's share of the clustered term is the pose's change when the cube is left
+  /// out, (H - H_c)^-1 g_c (a jackknife), instead of H^-1 g_c. Where a few cubes fix a
+  /// direction (an open square's few small objects), the fit absorbs part of each one's error
+  /// and its residual shows only (1 - leverage) of it; the jackknife restores it. H - H_c is
+  /// replaced by H - (1 - 1/cap) H_c >= H / cap: a cube widens its share at most cap times in
+  /// sd. 3 brings the square's yaw tail beyond 3 sd from 2.5 % to 1.3 % (BENCHMARK.md, "A
+  /// jackknife over the cubes"); <= 1 = off. In [0, 1e6].
+  double covariance_jackknife_cap = 3.0;
   /// A correspondence carries information along a translation axis only when its plane's
   /// normal leans towards it by at least this cosine (0.15: 8.6 deg): the small random tilts
   /// of fitted normals are not information. In [0, 1).
