@@ -65,7 +65,7 @@ struct Row {
   Eigen::Vector3d n;
   double w;
   Vector6 J;  // the residual's Jacobian (times jscale)
-  Vector6 wrJ;
+  double wr;  // w r: the row's gradient term is wr J
   Eigen::Vector3f m;
 };
 
@@ -87,7 +87,7 @@ inline bool addCorrespondence(Linearisation& L, const LocalPlane& plane, const E
     for (int b = a; b < 6; ++b) L.H(a, b) += wa * J[b];
   }
   const Vector6 wrJ = (w * r) * J;
-  if (rows) rows->push_back({plane.normal, w, J, wrJ, plane.mean.cast<float>()});
+  if (rows) rows->push_back({plane.normal, w, J, w * r, plane.mean.cast<float>()});
   L.g += wrJ;
   L.weight += w;
   L.weighted_r2 += w * r * r;
@@ -226,14 +226,14 @@ Vector6 step(const Linearisation& L, const Spectrum& s, double weak_ratio) {
 /// g_c the sum of the terms w r J of the correspondences in cell c (cubes of edge `cell` [m]
 /// in the reference frame): residuals that share a surface's model error (a trunk's tangent
 /// plane met by points on another side of the trunk) count once per cell, not once per point.
-/// H^-1 = S inv_s S (inv_s: the floored inverse of the scaled H, S = diag(scale)).
+/// H^-1 = S inv_s S (inv_s: the floored inverse of the scaled H, S = diag(scale); H unscaled).
 /// With jackknife_cap > 1, each cell's term is the pose's change when the cell is left out,
 /// (H - H_c)^-1 g_c (H_c = sum of w J J^T over the cell), instead of H^-1 g_c: a cell that
 /// alone fixes a direction (the few small objects of an open square) weighs as much as its
 /// leverage says. (H - (1 - 1/cap) H_c) replaces H - H_c, which is at least H / cap, so a cell
 /// widens the term along a direction at most cap times in standard deviation.
 Matrix6 clusteredCovariance(const std::vector<Row>& rows, double cell, const Vector6& scale,
-                            const Matrix6& inv_s, const Matrix6& Hs, double jackknife_cap) {
+                            const Matrix6& inv_s, const Matrix6& H, double jackknife_cap) {
   const float inv = float(1.0 / cell);
   detail::KeyIndex index(rows.size() / 8);
   const bool jackknife = jackknife_cap > 1.0;
@@ -250,11 +250,10 @@ Matrix6 clusteredCovariance(const std::vector<Row>& rows, double cell, const Vec
       cells.push_back(Vector6::Zero());
       if (jackknife) infos.push_back(Matrix6::Zero());
     }
-    cells[c] += row.wrJ;
+    cells[c] += row.wr * row.J;
     if (jackknife) infos[c].noalias() += row.w * row.J * row.J.transpose();
   }
   Matrix6 B = Matrix6::Zero();
-  const double keep = jackknife ? 1.0 - 1.0 / jackknife_cap : 0.0;
   if (!jackknife) {
     for (const Vector6& c : cells) {
       const Vector6 g = scale.asDiagonal() * c;
@@ -262,6 +261,8 @@ Matrix6 clusteredCovariance(const std::vector<Row>& rows, double cell, const Vec
     }
     return scale.asDiagonal() * inv_s * B * inv_s * scale.asDiagonal();
   }
+  const Matrix6 Hs = scale.asDiagonal() * H * scale.asDiagonal();
+  const double keep = 1.0 - 1.0 / jackknife_cap;
   for (std::size_t c = 0; c < cells.size(); ++c) {
     const Vector6 g = scale.asDiagonal() * cells[c];
     const Matrix6 Hc = scale.asDiagonal() * infos[c] * scale.asDiagonal();
@@ -396,8 +397,7 @@ PolishResult polishOnPlanes(const PlaneMap& map, const PointArray& scan, const P
                    sp.scale.asDiagonal();
   if (s.covariance_cell_m > 0.0 && s.covariance_cell_scale > 0.0) {
     res.covariance += s.covariance_cell_scale *
-                      clusteredCovariance(rows, s.covariance_cell_m, sp.scale, inv_s,
-                                          sp.scale.asDiagonal() * L.H * sp.scale.asDiagonal(),
+                      clusteredCovariance(rows, s.covariance_cell_m, sp.scale, inv_s, L.H,
                                           s.covariance_jackknife_cap);
   }
   res.weak_ratio = sp.max_eigenvalue > 0.0 ? sp.eig.eigenvalues()(0) / sp.max_eigenvalue : 0.0;

@@ -78,7 +78,7 @@ std::string algorithmOptionsHelp() {
          "                        (default " + num(d.polish.covariance_cell_m) + ")\n"
          "  --covariance-cell-scale K  times K (default " + num(d.polish.covariance_cell_scale) + ")\n"
          "  --covariance-jackknife C  each cube's clustered term left out (jackknife), widened\n"
-         "                        at most C times in sd; 0 = off (default " + num(d.polish.covariance_jackknife_cap) + ")\n"
+         "                        at most C times in sd; <= 1 = off (default " + num(d.polish.covariance_jackknife_cap) + ")\n"
          "  --coarse-max-points N the coarse search evaluates at most N collapsed points, 0 = all\n"
          "                        (default " + num(d.coarse_max_points) + ")\n"
          "  --refine-collapse F   the refine stage evaluates one point per voxel of F*E\n"
