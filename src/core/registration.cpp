@@ -340,6 +340,12 @@ void CubeRegistration::searchAttempt(const ScanPoints& points, const Pose6& gues
   // covariance.
   if (settings_.polish.enabled && res.J > 0 && reference_->planes.voxels() > 0) {
     const auto polish_start = Clock::now();
+    // J on the E grid before the polish moves the pose (a diagnostic: how many coincident cubes
+    // the point-to-plane optimum costs; the scene benchmark's CSV, BENCHMARK.md).
+    CoincidenceObjective& objective = workspaces_[0]->coarse;
+    objective.setScan(*points.full);
+    res.J_prepolish = objective(res.pose);
+    ++res.evaluations;
     polishStage(points, res);
     res.time_polish_s = seconds(polish_start, Clock::now());
   }

@@ -88,6 +88,10 @@ struct RegistrationResult {
   int iterations = 0;              ///< GNMM iterations, all runs.
   int restarts = 0;                ///< GNMM restarts, all runs.
   int J_coarse = 0;  ///< J at E after the first stage, on its points (dense_points filter).
+  /// J at E before the polish (after the refine, on the result's points; 0 when the polish did
+  /// not run). The polish moves the pose to the point-to-plane optimum, which can cost a few
+  /// coincident cubes; a large loss means it left the cubes' maximum.
+  int J_prepolish = 0;
   /// Searches run (1 + the retries that ran: SearchSettings::retries) and the one the result
   /// comes from (0 = the first).
   int attempts = 1;
