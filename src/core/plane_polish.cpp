@@ -24,6 +24,7 @@ void validate(const PolishSettings& s) {
   requireInRange("polish.tolerance_m", s.tolerance_m, 0.0, 0.1);
   requireInRange("polish.tolerance_rad", s.tolerance_rad, 0.0, 0.01);
   requireInRange("polish.max_overrelaxation", s.max_overrelaxation, 1.0, 4.0);
+  requireInRange("polish.round_steps", s.round_steps, 0, 100);
   requireInRange("polish.trilinear_sharpness", s.trilinear_sharpness, 1.0, 8.0);
   requireInRange("polish.collapse_fraction", s.collapse_fraction, 0.0, 2.0);
   requireInRange("polish.max_shift_m", s.max_shift_m, 1e-4, 10.0);
@@ -310,9 +311,11 @@ PolishResult polishOnPlanes(const PlaneMap& map, const PointArray& scan, const P
   // outliers have none): the lever arm that makes a rotation comparable with a translation.
   double rho = 1.0;
 
-  // Two rounds: each starts with a pass over every scan point that collects those near a plane,
-  // then iterates on them alone (the pose moves by millimetres). The second round collects
-  // them again at the first round's result, so the final set does not depend on the start.
+  // Rounds: each starts with a pass over every scan point that collects those near a plane,
+  // then iterates on them alone (the pose moves by millimetres). A round ends when it
+  // converges, or after round_steps steps (the set was collected where the pose no longer is);
+  // the polish ends after a converged round that started at a converged pose, so the final
+  // set is collected at the result and does not depend on the start.
   Linearisation L;
   bool converged = false;  // the last step was below the tolerances: L still holds there
   int it = 0;
@@ -333,11 +336,18 @@ PolishResult polishOnPlanes(const PlaneMap& map, const PointArray& scan, const P
   };
   double stretch = 1.0;  // over-relaxation of the last step
   Vector6 last_dx = Vector6::Zero();
-  for (int round = 0; round < 2 && it < s.max_iterations; ++round) {
+  bool started_converged = false;  // this round collected its points at a converged pose
+  while (it < s.max_iterations) {
     near.clear();
     near_corners.clear();
     converged = false;
-    for (bool collect = true; it < s.max_iterations; collect = false) {
+    bool cut = false;  // the round ran its round_steps steps without converging
+    for (int round_it = 0; it < s.max_iterations; ++round_it) {
+      if (s.round_steps > 0 && round_it >= s.round_steps) {
+        cut = true;
+        break;
+      }
+      const bool collect = round_it == 0;
       L = lineariseAt(collect);
       if (L.count < s.min_correspondences) break;
       if (it == 0) rho = radiusOfGyration(near);
@@ -358,7 +368,8 @@ PolishResult polishOnPlanes(const PlaneMap& map, const PointArray& scan, const P
         break;
       }
     }
-    if (!converged) break;
+    if ((!converged && !cut) || (converged && started_converged)) break;
+    started_converged = converged;
   }
   // The covariance and the weak axes from each point's own voxel's plane (with the trilinear
   // pairs, a floor point near a wall would also meet the wall's plane: a residual of the

@@ -73,6 +73,8 @@ std::string algorithmOptionsHelp() {
          "                        normalised; 1 = plain trilinear (default " + num(d.polish.trilinear_sharpness) + ")\n"
          "  --polish-overrelax F  a polish step along the last one's direction is stretched\n"
          "                        up to F times, 1 = plain Gauss-Newton (default " + num(d.polish.max_overrelaxation) + ")\n"
+         "  --polish-round-steps N  steps per round of the polish before its points are\n"
+         "                        collected again; 0 = only when a round converges (default " + std::to_string(d.polish.round_steps) + ")\n"
          "  --covariance-scale C  the polish's covariance is C x sigma^2 H^-1 (default " + num(d.polish.covariance_scale) + ")\n"
          "  --covariance-cell M   plus the clustered covariance over cubes of M m, 0 = off\n"
          "                        (default " + num(d.polish.covariance_cell_m) + ")\n"
@@ -165,6 +167,8 @@ bool parseAlgorithmOption(const std::vector<std::string>& args, std::size_t& i,
     s.polish.trilinear_sharpness = value(1), used = 2;
   } else if (a == "--polish-overrelax") {
     s.polish.max_overrelaxation = value(1), used = 2;
+  } else if (a == "--polish-round-steps") {
+    s.polish.round_steps = int(value(1)), used = 2;
   } else if (a == "--covariance-scale") {
     s.polish.covariance_scale = value(1), used = 2;
   } else if (a == "--covariance-cell") {

@@ -289,6 +289,38 @@ TEST(PlanePolish, OverRelaxationReachesThePlainPoseInFewerSteps) {
   EXPECT_LT(b.iterations, a.iterations);
 }
 
+// A round of the polish iterates on the points it collected at its start; round_steps makes it
+// collect them again after that many steps without converging. From a start 12 cm / 0.6 deg
+// off, where the first round needs more steps than that, collecting again every 3 or 8 steps
+// must end on the pose of rounds that end only when they converge (the same fixed point,
+// collected at the result), within the iteration budget.
+TEST(PlanePolish, CollectingThePointsAgainKeepsTheFixedPoint) {
+  const PointArray reference = makeScene(false, 2);
+  const Eigen::Isometry3d truth = truthTransform();
+  const PointArray scan = transformed(makeScene(false, 3), truth.inverse());
+  const PlaneMap map(reference, 0.25, 6, 0.1);
+  Pose6 start = isometryToPose(truth);
+  start.head<3>() += Eigen::Vector3d(0.10, -0.06, 0.03);
+  start.tail<3>() += Eigen::Vector3d(0.002, -0.004, 0.008);
+  PolishSettings s;
+  s.max_iterations = 60;
+  s.round_steps = 0;
+  const PolishResult whole = polishOnPlanes(map, scan, start, s);
+  ASSERT_TRUE(whole.applied) << whole.reason;
+  ASSERT_GT(whole.iterations, 3);  // the first round needs more steps than the shortest rounds
+  for (const int steps : {3, 8}) {
+    s.round_steps = steps;
+    const PolishResult r = polishOnPlanes(map, scan, start, s);
+    ASSERT_TRUE(r.applied) << r.reason;
+    EXPECT_LT(r.iterations, s.max_iterations) << steps;
+    const Eigen::Isometry3d a = poseToIsometry(whole.pose), b = poseToIsometry(r.pose);
+    EXPECT_LT((a.translation() - b.translation()).norm(), 3e-4) << steps;
+    EXPECT_LT(rad2deg(Eigen::AngleAxisd(a.linear() * b.linear().transpose()).angle()), 0.003)
+        << steps;
+    EXPECT_LT((b.translation() - truth.translation()).norm(), 0.005) << steps;
+  }
+}
+
 // Trilinear correspondences make the objective continuous in the pose: polishes started up to
 // 3 cm / 0.3 deg apart must end on one pose, with plain trilinear weights (p = 1, the default)
 // as with sharpened ones (p = 2); with one plane per point (each point's own voxel)
@@ -378,6 +410,12 @@ TEST(PlanePolish, SettingsAreValidated) {
   s.covariance_jackknife_cap = std::nan("");
   EXPECT_THROW(validate(s), std::invalid_argument);
   s.covariance_jackknife_cap = 10.0;
+  EXPECT_NO_THROW(validate(s));
+  s.round_steps = -1;
+  EXPECT_THROW(validate(s), std::invalid_argument);
+  s.round_steps = 101;
+  EXPECT_THROW(validate(s), std::invalid_argument);
+  s.round_steps = 0;  // rounds end only when they converge
   EXPECT_NO_THROW(validate(s));
   s.covariance_scale = 0.5;
   s.enabled = false;  // not checked when off

@@ -56,6 +56,14 @@ struct PolishSettings {
   /// weights make the plain steps fall short when the cube result is a few cm off (1-2 cm per
   /// step, 20 steps); the fixed point is the same. 1 = plain Gauss-Newton. In [1, 4].
   double max_overrelaxation = 2.0;
+  /// Gauss-Newton steps per round of the polish: a round iterates on the scan points it
+  /// collected near a plane at its start; with N > 0, after N steps without converging it
+  /// collects them again where the pose is now (on one set for long, the steps can drift to
+  /// where that set fits best as points leave their planes: an open square's 0.49 deg yaw
+  /// drift, accepted 10.5 cm off). 8 removes that false accept but adds another with the
+  /// sensor's artefacts (BENCHMARK.md, "The polish's rounds"), so 0 stays the default: a round
+  /// ends only when it converges (two rounds). In [0, 100].
+  int round_steps = 0;
   /// The polish evaluates the scan collapsed to one point per voxel of this * E (the refine
   /// stage's points when equal to refine.collapse_fraction). 0 = all points. In [0, 2].
   double collapse_fraction = 0.5;
