@@ -342,18 +342,13 @@ void CubeRegistration::searchAttempt(const ScanPoints& points, const Pose6& gues
     const auto polish_start = Clock::now();
     // J on the E grid before the polish moves the pose (a diagnostic: how many coincident cubes
     // the point-to-plane optimum costs; the scene benchmark's CSV, BENCHMARK.md).
-    CoincidenceObjective& objective = workspaces_[0]->coarse;
-    objective.setScan(*points.full);
-    res.J_prepolish = objective(res.pose);
+    res.J_prepolish = resultObjective(points)(res.pose);
     ++res.evaluations;
     polishStage(points, res);
     res.time_polish_s = seconds(polish_start, Clock::now());
   }
   if (res.J > 0 && (rs.enabled || res.polished)) {
-    // J on the E grid at the result, on all points collapsed as for the coarse stage.
-    CoincidenceObjective& objective = workspaces_[0]->coarse;
-    objective.setScan(*points.full);
-    res.J = objective(res.pose);
+    res.J = resultObjective(points)(res.pose);
   }
   if (res.polished && !res.degenerate && settings_.search.axis_probe_m > 0.0) {
     const auto probe_start = Clock::now();
@@ -362,10 +357,16 @@ void CubeRegistration::searchAttempt(const ScanPoints& points, const Pose6& gues
   }
 }
 
+CoincidenceObjective& CubeRegistration::resultObjective(const ScanPoints& points) const {
+  CoincidenceObjective& objective = workspaces_[0]->coarse;
+  objective.setScan(*points.full);
+  return objective;
+}
+
 void CubeRegistration::axisProbeStage(const ScanPoints& points, RegistrationResult& res) const {
   const SearchSettings& ss = settings_.search;
   const double step = settings_.grid.cube_edge / 4.0;
-  CoincidenceObjective& objective = workspaces_[0]->coarse;  // bound to points.full
+  CoincidenceObjective& objective = resultObjective(points);
   Pose6 best_pose = res.pose;
   int best = res.J;
   for (double d = step; d <= ss.axis_probe_m + 1e-9; d += step) {

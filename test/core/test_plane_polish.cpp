@@ -71,6 +71,20 @@ Eigen::Isometry3d truthTransform() {
   return T;
 }
 
+// The test pair: the reference scene, the truth (scan -> reference), the scan seen from it and
+// the reference's plane map (0.25 m voxels).
+struct KnownPair {
+  explicit KnownPair(bool corridor)
+      : reference(makeScene(corridor, 2)),
+        truth(truthTransform()),
+        scan(transformed(makeScene(corridor, 3), truth.inverse())),
+        map(reference, 0.25, 6, 0.1) {}
+  PointArray reference;
+  Eigen::Isometry3d truth;
+  PointArray scan;
+  PlaneMap map;
+};
+
 }  // namespace
 
 TEST(PlaneMap, FitsTheSurfaceAndRefusesLinesAndEmptySpace) {
@@ -91,19 +105,16 @@ TEST(PlaneMap, FitsTheSurfaceAndRefusesLinesAndEmptySpace) {
 }
 
 TEST(PlanePolish, ConvergesToTheKnownTransformFromCentimetresOff) {
-  const PointArray reference = makeScene(false, 2);
-  const Eigen::Isometry3d truth = truthTransform();  // scan -> reference
-  const PointArray scan = transformed(makeScene(false, 3), truth.inverse());
-  const PlaneMap map(reference, 0.25, 6, 0.1);
+  const KnownPair known(false);
   const PolishSettings s;
-  Pose6 start = isometryToPose(truth);
+  Pose6 start = isometryToPose(known.truth);
   start.head<3>() += Eigen::Vector3d(0.04, -0.03, 0.02);
   start.tail<3>() += Eigen::Vector3d(0.004, -0.003, 0.005);  // 0.2-0.3 deg
-  const PolishResult r = polishOnPlanes(map, scan, start, s);
+  const PolishResult r = polishOnPlanes(known.map, known.scan, start, s);
   ASSERT_TRUE(r.applied) << r.reason;
   const Eigen::Isometry3d est = poseToIsometry(r.pose);
-  EXPECT_LT((est.translation() - truth.translation()).norm(), 0.002);
-  EXPECT_LT(rad2deg(Eigen::AngleAxisd(est.linear() * truth.linear().transpose()).angle()), 0.02);
+  EXPECT_LT((est.translation() - known.truth.translation()).norm(), 0.002);
+  EXPECT_LT(rad2deg(Eigen::AngleAxisd(est.linear() * known.truth.linear().transpose()).angle()), 0.02);
   EXPECT_FALSE(r.degenerate) << r.weak_ratio;
   EXPECT_LT(r.rms, 0.02);
   // The covariance is symmetric positive definite, with standard deviations below a millimetre
@@ -116,10 +127,10 @@ TEST(PlanePolish, ConvergesToTheKnownTransformFromCentimetresOff) {
   // term adds to it.
   PolishSettings plain = s;
   plain.covariance_cell_m = 0.0;
-  const PolishResult r1 = polishOnPlanes(map, scan, start, plain);
+  const PolishResult r1 = polishOnPlanes(known.map, known.scan, start, plain);
   PolishSettings scaled = plain;
   scaled.covariance_scale = 4.0 * s.covariance_scale;
-  const PolishResult r4 = polishOnPlanes(map, scan, start, scaled);
+  const PolishResult r4 = polishOnPlanes(known.map, known.scan, start, scaled);
   EXPECT_NEAR(r4.covariance(0, 0), 4.0 * r1.covariance(0, 0), 1e-15);
   for (int k = 0; k < 6; ++k) EXPECT_GE(r.covariance(k, k), r1.covariance(k, k));
 }
@@ -244,18 +255,15 @@ TEST(PlanePolish, TheJackknifeWidensWhatFewCubesFix) {
 }
 
 TEST(PlanePolish, ACorridorIsFlaggedAlongItsAxisAndNotMovedAlongIt) {
-  const PointArray reference = makeScene(true, 2);
-  const Eigen::Isometry3d truth = truthTransform();
-  const PointArray scan = transformed(makeScene(true, 3), truth.inverse());
-  const PlaneMap map(reference, 0.25, 6, 0.1);
-  Pose6 start = isometryToPose(truth);
+  const KnownPair known(true);
+  Pose6 start = isometryToPose(known.truth);
   start[0] += 0.05;  // 5 cm along the corridor: nothing can tell
   start[1] += 0.03;  // 3 cm across it: the walls fix it
-  const PolishResult r = polishOnPlanes(map, scan, start, PolishSettings{});
+  const PolishResult r = polishOnPlanes(known.map, known.scan, start, PolishSettings{});
   ASSERT_TRUE(r.applied) << r.reason;
   EXPECT_TRUE(r.degenerate) << r.weak_ratio;
   EXPECT_GT(std::abs(r.weak_direction[0]), 0.9);  // along x
-  EXPECT_NEAR(r.pose[1], isometryToPose(truth)[1], 0.003);
+  EXPECT_NEAR(r.pose[1], isometryToPose(known.truth)[1], 0.003);
   EXPECT_NEAR(r.pose[0], start[0], 0.01);  // left where the cube stages put it
   // Its predicted standard deviation along the axis dwarfs the one across it.
   EXPECT_GT(r.covariance(0, 0), 100.0 * r.covariance(1, 1));
@@ -265,27 +273,24 @@ TEST(PlanePolish, ACorridorIsFlaggedAlongItsAxisAndNotMovedAlongIt) {
 // that the robust weights shorten the plain Gauss-Newton steps, it must land on the plain
 // iteration's pose (the same fixed point) in fewer steps.
 TEST(PlanePolish, OverRelaxationReachesThePlainPoseInFewerSteps) {
-  const PointArray reference = makeScene(false, 2);
-  const Eigen::Isometry3d truth = truthTransform();
-  const PointArray scan = transformed(makeScene(false, 3), truth.inverse());
-  const PlaneMap map(reference, 0.25, 6, 0.1);
+  const KnownPair known(false);
   PolishSettings plain;
   plain.trilinear = false;  // the piecewise objective, where the plain steps fall short
   plain.max_overrelaxation = 1.0;
   plain.max_iterations = 100;
   PolishSettings relaxed = plain;
   relaxed.max_overrelaxation = 2.0;
-  Pose6 start = isometryToPose(truth);
+  Pose6 start = isometryToPose(known.truth);
   start.head<3>() += Eigen::Vector3d(0.10, -0.06, 0.03);
   start.tail<3>() += Eigen::Vector3d(0.002, -0.002, 0.008);
-  const PolishResult a = polishOnPlanes(map, scan, start, plain);
-  const PolishResult b = polishOnPlanes(map, scan, start, relaxed);
+  const PolishResult a = polishOnPlanes(known.map, known.scan, start, plain);
+  const PolishResult b = polishOnPlanes(known.map, known.scan, start, relaxed);
   ASSERT_TRUE(a.applied) << a.reason;
   ASSERT_TRUE(b.applied) << b.reason;
   const Eigen::Isometry3d ta = poseToIsometry(a.pose), tb = poseToIsometry(b.pose);
   EXPECT_LT((ta.translation() - tb.translation()).norm(), 1e-3);
   EXPECT_LT(rad2deg(Eigen::AngleAxisd(ta.linear() * tb.linear().transpose()).angle()), 0.01);
-  EXPECT_LT((tb.translation() - truth.translation()).norm(), 0.002);
+  EXPECT_LT((tb.translation() - known.truth.translation()).norm(), 0.002);
   EXPECT_LT(b.iterations, a.iterations);
 }
 
@@ -295,29 +300,26 @@ TEST(PlanePolish, OverRelaxationReachesThePlainPoseInFewerSteps) {
 // must end on the pose of rounds that end only when they converge (the same fixed point,
 // collected at the result), within the iteration budget.
 TEST(PlanePolish, CollectingThePointsAgainKeepsTheFixedPoint) {
-  const PointArray reference = makeScene(false, 2);
-  const Eigen::Isometry3d truth = truthTransform();
-  const PointArray scan = transformed(makeScene(false, 3), truth.inverse());
-  const PlaneMap map(reference, 0.25, 6, 0.1);
-  Pose6 start = isometryToPose(truth);
+  const KnownPair known(false);
+  Pose6 start = isometryToPose(known.truth);
   start.head<3>() += Eigen::Vector3d(0.10, -0.06, 0.03);
   start.tail<3>() += Eigen::Vector3d(0.002, -0.004, 0.008);
   PolishSettings s;
   s.max_iterations = 60;
   s.round_steps = 0;
-  const PolishResult whole = polishOnPlanes(map, scan, start, s);
+  const PolishResult whole = polishOnPlanes(known.map, known.scan, start, s);
   ASSERT_TRUE(whole.applied) << whole.reason;
   ASSERT_GT(whole.iterations, 3);  // the first round needs more steps than the shortest rounds
   for (const int steps : {3, 8}) {
     s.round_steps = steps;
-    const PolishResult r = polishOnPlanes(map, scan, start, s);
+    const PolishResult r = polishOnPlanes(known.map, known.scan, start, s);
     ASSERT_TRUE(r.applied) << r.reason;
     EXPECT_LT(r.iterations, s.max_iterations) << steps;
     const Eigen::Isometry3d a = poseToIsometry(whole.pose), b = poseToIsometry(r.pose);
     EXPECT_LT((a.translation() - b.translation()).norm(), 3e-4) << steps;
     EXPECT_LT(rad2deg(Eigen::AngleAxisd(a.linear() * b.linear().transpose()).angle()), 0.003)
         << steps;
-    EXPECT_LT((b.translation() - truth.translation()).norm(), 0.005) << steps;
+    EXPECT_LT((b.translation() - known.truth.translation()).norm(), 0.005) << steps;
   }
 }
 
@@ -326,10 +328,7 @@ TEST(PlanePolish, CollectingThePointsAgainKeepsTheFixedPoint) {
 // as with sharpened ones (p = 2); with one plane per point (each point's own voxel)
 // they end where the steps of the piecewise objective leave them.
 TEST(PlanePolish, TrilinearCorrespondencesEndOnOnePoseFromEveryStart) {
-  const PointArray reference = makeScene(false, 2);
-  const Eigen::Isometry3d truth = truthTransform();
-  const PointArray scan = transformed(makeScene(false, 3), truth.inverse());
-  const PlaneMap map(reference, 0.25, 6, 0.1);
+  const KnownPair known(false);
   auto spread = [&](bool trilinear, double sharpness) {
     PolishSettings s;
     s.trilinear = trilinear;
@@ -338,10 +337,10 @@ TEST(PlanePolish, TrilinearCorrespondencesEndOnOnePoseFromEveryStart) {
     std::uniform_real_distribution<double> u(-1.0, 1.0);
     std::vector<Eigen::Isometry3d> ends;
     for (int k = 0; k < 12; ++k) {
-      Pose6 start = isometryToPose(truth);
+      Pose6 start = isometryToPose(known.truth);
       for (int i = 0; i < 3; ++i) start[i] += 0.03 * u(rng);
       for (int i = 3; i < 6; ++i) start[i] += deg2rad(0.3) * u(rng);
-      const PolishResult r = polishOnPlanes(map, scan, start, s);
+      const PolishResult r = polishOnPlanes(known.map, known.scan, start, s);
       EXPECT_TRUE(r.applied) << r.reason;
       ends.push_back(poseToIsometry(r.pose));
     }

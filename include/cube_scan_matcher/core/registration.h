@@ -194,6 +194,9 @@ class CubeRegistration {
   void refineStage(const ScanPoints& points, const std::vector<Pose6>& ranked,
                    RegistrationResult& res) const;
   void polishStage(const ScanPoints& points, RegistrationResult& res) const;
+  /// The E grid's objective bound to all the scan's points, collapsed as for the coarse stage:
+  /// J at a result, before and after the polish and along the axis probe.
+  CoincidenceObjective& resultObjective(const ScanPoints& points) const;
   /// Coarse, refine and polish stages from the seeds of `attempt` (0 = the first).
   void axisProbeStage(const ScanPoints& points, RegistrationResult& res) const;
   void searchAttempt(const ScanPoints& points, const Pose6& guess, int attempt,
