@@ -5,10 +5,16 @@
 usage: /usr/bin/python3 scripts/plot_scenes.py OUT.png SCENES.csv [LABEL]
        /usr/bin/python3 scripts/plot_scenes.py --table SCENES.csv [SCENES.csv ...]
        /usr/bin/python3 scripts/plot_scenes.py --calibrate SCENES.csv [SCENES.csv ...]
+       /usr/bin/python3 scripts/plot_scenes.py --targets SCENES.csv [SCENES.csv ...]
 
 --calibrate: for the accepted successful registrations with a covariance, the fraction of each
 axis's errors beyond 3 predicted standard deviations, and the smallest factor on the
 covariance (covariance_scale, relative to the run's) that brings every axis to <= 1 %.
+
+--targets: issue 12's targets per scene type, the CSVs pooled: successes from the big starts
+(>= 99.5 %) and from all; median / p95 Es and Ea of the accepted results (<= 2 cm, 0.1 deg /
+5 cm, 0.3 deg); false accepts (0); false rejects as a share of the right results (<= 1 %); the
+accepted results' worst axis beyond 3 predicted sd (<= 1 %); and the targets each type misses.
 """
 import csv
 import sys
@@ -87,6 +93,50 @@ def calibrate(paths):
     print("covariance_scale factor for every axis: %.1f (times the run's covariance_scale)" % worst)
 
 
+def targets(paths):
+    by = OrderedDict()
+    for path in paths:
+        with open(path) as fh:
+            for r in csv.DictReader(fh):
+                by.setdefault(r["scene"], []).append(r)
+    print("| scene | n | success, big starts | success, all | accepted: Es median / p95 [m] | "
+          "Ea median / p95 [deg] | false accepts | false rejects | worst axis > 3 sd | misses |")
+    print("|---|---|---|---|---|---|---|---|---|---|")
+    for scene, rows in sorted(by.items()):
+        ok = [r["success"] == "1" for r in rows]
+        acc = [r for r in rows if r["gate"] == "accepted"]
+        big = [r["success"] == "1" for r in rows if r["bounds"] == "big"]
+        fa = sum(r["success"] != "1" for r in acc)
+        fr = sum(s and r["gate"] != "accepted" for r, s in zip(rows, ok))
+        es = [float(r["Es_m"]) for r in acc]
+        ea = [float(r["Ea_deg"]) for r in acc]
+        per_axis = [0] * 6
+        for r in acc:
+            for k in range(6):
+                sig = float(r[SIG[k]])
+                per_axis[k] += sig > 0.0 and abs(float(r[ERR[k]])) > 3.0 * sig
+        worst = max(per_axis)
+        n_acc = max(len(acc), 1)
+        pct = lambda a, b: 100.0 * a / max(b, 1)
+        misses = []
+        if pct(sum(big), len(big)) < 99.5:
+            misses.append("success")
+        if acc and (quantile(es, 0.5) > 0.02 or quantile(ea, 0.5) > 0.1 or
+                    quantile(es, 0.95) > 0.05 or quantile(ea, 0.95) > 0.3):
+            misses.append("accuracy")
+        if fa:
+            misses.append("false accepts")
+        if pct(fr, sum(ok)) > 1.0:
+            misses.append("false rejects")
+        if pct(worst, n_acc) > 1.0:
+            misses.append("calibration (%s)" % AXES[per_axis.index(worst)])
+        print("| %s | %d | %.1f %% | %.1f %% | %s | %s | %d | %d (%.1f %%) | %.1f %% | %s |" % (
+            scene, len(rows), pct(sum(big), len(big)), pct(sum(ok), len(rows)),
+            "%.3f / %.3f" % (quantile(es, 0.5), quantile(es, 0.95)) if acc else "-",
+            "%.2f / %.2f" % (quantile(ea, 0.5), quantile(ea, 0.95)) if acc else "-",
+            fa, fr, pct(fr, sum(ok)), pct(worst, n_acc), ", ".join(misses) or "none"))
+
+
 def plot(out, path, label):
     g = groups(path)
     fig, axes = plt.subplots(2, 1, figsize=(11, 7), sharex=True)
@@ -115,6 +165,8 @@ def plot(out, path, label):
 if __name__ == "__main__":
     if len(sys.argv) >= 3 and sys.argv[1] == "--table":
         table(sys.argv[2:])
+    elif len(sys.argv) >= 3 and sys.argv[1] == "--targets":
+        targets(sys.argv[2:])
     elif len(sys.argv) >= 3 and sys.argv[1] == "--calibrate":
         calibrate(sys.argv[2:])
     elif len(sys.argv) in (3, 4):

@@ -383,6 +383,7 @@ PolishResult polishOnPlanes(const PlaneMap& map, const PointArray& scan, const P
   }
   const double shift_m = (t - T0.translation()).norm();
   const double shift_rad = rotationAngle(R * T0.linear().transpose());
+  res.shift_m = shift_m, res.shift_rad = shift_rad;
   if (!(shift_m <= s.max_shift_m) || !(shift_rad <= s.max_shift_rad)) {
     res.reason = "the polish left the cube result's basin";
     return res;

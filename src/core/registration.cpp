@@ -309,6 +309,7 @@ void CubeRegistration::polishStage(const ScanPoints& points, RegistrationResult&
   res.polish_iterations = p.iterations;
   res.polish_points = int(points.polish->size());
   res.plane_correspondences = p.correspondences;
+  res.polish_shift_m = p.shift_m, res.polish_shift_rad = p.shift_rad;
   if (!p.applied) return;
   res.pose = p.pose;
   res.plane_rms = p.rms;

@@ -80,6 +80,7 @@ struct Row {
   bool degenerate = false;
   double weak_ratio = 0.0, t_weak_ratio = 0.0;
   int J_prepolish = 0;
+  double shift_m = 0.0, shift_deg = 0.0;
   bool polished = false;
   double plane_rms = 0.0, plane_fraction = 0.0;
   int agreeing = 0, J_runner_up = 0, J_coarse = 0, attempts = 1, J_axis = 0;
@@ -190,7 +191,7 @@ int main(int argc, char** argv) {
            "ex_m,ey_m,ez_m,erx_rad,ery_rad,erz_rad,sx_m,sy_m,sz_m,srx_rad,sry_rad,srz_rad,"
            "degenerate,weak_ratio,polished,plane_rms_m,plane_fraction,"
            "starts_agreeing,J_runner_up,J_coarse,t_weak_ratio,attempts,J_axis,axis_moved,consensus,"
-           "J_prepolish\n";
+           "J_prepolish,polish_shift_m,polish_shift_deg\n";
     CubeRegistration reg(settings);
     const GateSettings gate_settings;
     const sim::ScannerModel model = artefacts ? sim::scannerWithArtefacts() : sim::ScannerModel{};
@@ -241,6 +242,8 @@ int main(int argc, char** argv) {
               row.J_runner_up = r.J_runner_up;
               row.J_coarse = r.J_coarse;
               row.J_prepolish = r.J_prepolish;
+              row.shift_m = r.polish_shift_m;
+              row.shift_deg = rad2deg(r.polish_shift_rad);
               row.plane_fraction =
                   r.polish_points ? double(r.plane_correspondences) / r.polish_points : 0.0;
               csv << row.scene << ',' << w << ',' << t << ',' << row.motion << ',' << row.bounds
@@ -253,7 +256,8 @@ int main(int argc, char** argv) {
                   << ',' << row.plane_rms << ',' << row.plane_fraction << ',' << row.agreeing << ','
                   << row.J_runner_up << ',' << row.J_coarse << ',' << row.t_weak_ratio << ','
                   << row.attempts << ',' << row.J_axis << ',' << int(row.axis_moved) << ','
-                  << int(row.consensus) << ',' << row.J_prepolish << '\n';
+                  << int(row.consensus) << ',' << row.J_prepolish << ',' << row.shift_m << ','
+                  << row.shift_deg << '\n';
               rows.push_back(row);
               if (repeat > 1) {
                 std::vector<Eigen::Isometry3d> estimates{r.transform};

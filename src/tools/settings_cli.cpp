@@ -75,6 +75,8 @@ std::string algorithmOptionsHelp() {
          "                        up to F times, 1 = plain Gauss-Newton (default " + num(d.polish.max_overrelaxation) + ")\n"
          "  --polish-round-steps N  steps per round of the polish before its points are\n"
          "                        collected again; 0 = only when a round converges (default " + std::to_string(d.polish.round_steps) + ")\n"
+         "  --polish-max-shift M D  the polish is not applied when it moves the pose more than\n"
+         "                        M m or D deg (default " + num(d.polish.max_shift_m) + " " + num(rad2deg(d.polish.max_shift_rad)) + ")\n"
          "  --covariance-scale C  the polish's covariance is C x sigma^2 H^-1 (default " + num(d.polish.covariance_scale) + ")\n"
          "  --covariance-cell M   plus the clustered covariance over cubes of M m, 0 = off\n"
          "                        (default " + num(d.polish.covariance_cell_m) + ")\n"
@@ -167,6 +169,8 @@ bool parseAlgorithmOption(const std::vector<std::string>& args, std::size_t& i,
     s.polish.trilinear_sharpness = value(1), used = 2;
   } else if (a == "--polish-overrelax") {
     s.polish.max_overrelaxation = value(1), used = 2;
+  } else if (a == "--polish-max-shift") {
+    s.polish.max_shift_m = value(1), s.polish.max_shift_rad = deg2rad(value(2)), used = 3;
   } else if (a == "--polish-round-steps") {
     s.polish.round_steps = int(value(1)), used = 2;
   } else if (a == "--covariance-scale") {

@@ -117,6 +117,10 @@ TEST(PlanePolish, ConvergesToTheKnownTransformFromCentimetresOff) {
   EXPECT_LT(rad2deg(Eigen::AngleAxisd(est.linear() * known.truth.linear().transpose()).angle()), 0.02);
   EXPECT_FALSE(r.degenerate) << r.weak_ratio;
   EXPECT_LT(r.rms, 0.02);
+  // It reports how far it moved the pose: the start's offset, 5.4 cm and 0.3-0.4 deg.
+  EXPECT_NEAR(r.shift_m, (start.head<3>() - isometryToPose(known.truth).head<3>()).norm(), 0.003);
+  EXPECT_GT(rad2deg(r.shift_rad), 0.2);
+  EXPECT_LT(rad2deg(r.shift_rad), 0.5);
   // The covariance is symmetric positive definite, with standard deviations below a millimetre
   // for thousands of points with 1 cm noise (times the default covariance_scale).
   EXPECT_LT((r.covariance - r.covariance.transpose()).norm(), 1e-15);
@@ -365,6 +369,23 @@ TEST(PlanePolish, TrilinearCorrespondencesEndOnOnePoseFromEveryStart) {
   RecordProperty("spread_own_voxel_mm", std::to_string(t1 * 1e3));
   std::printf("polish end spread over 12 starts: trilinear p = 1 %.3f mm / %.4f deg, p = 2 %.3f mm / %.4f deg, own voxel %.3f mm / %.4f deg\n",
               t3 * 1e3, deg3, tp * 1e3, degp, t1 * 1e3, deg1);
+}
+
+TEST(PlanePolish, RefusesToMoveFurtherThanItsMaxShift) {
+  const KnownPair known(false);
+  Pose6 start = isometryToPose(known.truth);
+  start.head<3>() += Eigen::Vector3d(0.04, -0.03, 0.02);  // 5.4 cm off
+  PolishSettings s;
+  s.max_shift_m = 0.03;
+  const PolishResult r = polishOnPlanes(known.map, known.scan, start, s);
+  EXPECT_FALSE(r.applied);
+  EXPECT_EQ(r.reason, "the polish left the cube result's basin");
+  EXPECT_EQ(r.pose, start);            // the cube result is kept
+  EXPECT_GT(r.shift_m, s.max_shift_m);  // and the shift that was refused is reported
+  s.max_shift_m = PolishSettings().max_shift_m;
+  s.max_shift_rad = deg2rad(0.01);  // the rotation bound alone refuses it too
+  start.tail<3>() += Eigen::Vector3d(0.0, 0.0, 0.002);
+  EXPECT_FALSE(polishOnPlanes(known.map, known.scan, start, s).applied);
 }
 
 TEST(PlanePolish, GivesUpWithoutPlanesAndKeepsThePose) {

@@ -60,16 +60,20 @@ struct PolishSettings {
   /// collected near a plane at its start; with N > 0, after N steps without converging it
   /// collects them again where the pose is now (on one set for long, the steps can drift to
   /// where that set fits best as points leave their planes: an open square's 0.49 deg yaw
-  /// drift, accepted 10.5 cm off). 8 removes that false accept but adds another with the
-  /// sensor's artefacts (BENCHMARK.md, "The polish's rounds"), so 0 stays the default: a round
-  /// ends only when it converges (two rounds). In [0, 100].
-  int round_steps = 0;
+  /// drift, accepted 10.5 cm off). 8 removes that false accept; with max_shift_m 0.2 m it
+  /// does not add another (BENCHMARK.md, "The polish's rounds" and "A polish that must stay
+  /// near the cube result"). 0 = a round ends only when it converges. In [0, 100].
+  int round_steps = 8;
   /// The polish evaluates the scan collapsed to one point per voxel of this * E (the refine
   /// stage's points when equal to refine.collapse_fraction). 0 = all points. In [0, 2].
   double collapse_fraction = 0.5;
-  /// The polish is discarded (the cube result kept) when it moves the pose more than
-  /// max_shift_m or max_shift_rad from the cube result, or finds fewer than min_correspondences.
-  double max_shift_m = 0.25;
+  /// The polish is discarded (the cube result kept, the result unconfirmed, so searched again)
+  /// when it moves the pose more than max_shift_m or max_shift_rad from the cube result, or
+  /// finds fewer than min_correspondences. 0.2 m (0.4 E; was 0.25 m until session 23): a
+  /// polish that starts 0.2 m / 0.5 deg off after a poor refine walked 0.2497 m to a pose
+  /// 11 cm off; right results move up to 0.24 m (robot worlds, p99 0.19 m), so this costs
+  /// 13 of 5 900 accepted right results in the robot worlds and artefacts (BENCHMARK.md).
+  double max_shift_m = 0.2;
   double max_shift_rad = 0.03490658503988659;  // 2 deg
   int min_correspondences = 50;
   /// Directions whose information is below weak_ratio times the strongest one (in units where
@@ -125,6 +129,9 @@ struct PolishResult {
   Pose6 pose = Pose6::Zero();
   int iterations = 0;
   int correspondences = 0;  ///< scan points with a plane within one voxel at the result.
+  /// How far the polish moved the pose from the cube result [m], [rad] (also when it is not
+  /// applied because of max_shift_m / max_shift_rad; 0 when it found too few planes).
+  double shift_m = 0.0, shift_rad = 0.0;
   double rms = 0.0;         ///< weighted RMS point-to-plane distance at the result [m].
   /// Covariance of [x y z, rotation about the reference frame's x y z] [m^2, rad^2]: small
   /// rotations applied on the left (R' = exp(dtheta) R, t' = t + dt), as ROS's

@@ -92,6 +92,9 @@ struct RegistrationResult {
   /// not run). The polish moves the pose to the point-to-plane optimum, which can cost a few
   /// coincident cubes; a large loss means it left the cubes' maximum.
   int J_prepolish = 0;
+  /// How far the polish moved the pose from the refine's result [m], [rad] (a diagnostic; 0
+  /// when it did not run; PolishResult::shift_m).
+  double polish_shift_m = 0.0, polish_shift_rad = 0.0;
   /// Searches run (1 + the retries that ran: SearchSettings::retries) and the one the result
   /// comes from (0 = the first).
   int attempts = 1;
