@@ -93,6 +93,10 @@ def calibrate(paths):
     print("covariance_scale factor for every axis: %.1f (times the run's covariance_scale)" % worst)
 
 
+def pct(part, whole):
+    return 100.0 * part / max(whole, 1)
+
+
 def targets(paths):
     by = OrderedDict()
     for path in paths:
@@ -116,8 +120,6 @@ def targets(paths):
                 sig = float(r[SIG[k]])
                 per_axis[k] += sig > 0.0 and abs(float(r[ERR[k]])) > 3.0 * sig
         worst = max(per_axis)
-        n_acc = max(len(acc), 1)
-        pct = lambda a, b: 100.0 * a / max(b, 1)
         misses = []
         if pct(sum(big), len(big)) < 99.5:
             misses.append("success")
@@ -128,13 +130,13 @@ def targets(paths):
             misses.append("false accepts")
         if pct(fr, sum(ok)) > 1.0:
             misses.append("false rejects")
-        if pct(worst, n_acc) > 1.0:
+        if pct(worst, len(acc)) > 1.0:
             misses.append("calibration (%s)" % AXES[per_axis.index(worst)])
         print("| %s | %d | %.1f %% | %.1f %% | %s | %s | %d | %d (%.1f %%) | %.1f %% | %s |" % (
             scene, len(rows), pct(sum(big), len(big)), pct(sum(ok), len(rows)),
             "%.3f / %.3f" % (quantile(es, 0.5), quantile(es, 0.95)) if acc else "-",
             "%.2f / %.2f" % (quantile(ea, 0.5), quantile(ea, 0.95)) if acc else "-",
-            fa, fr, pct(fr, sum(ok)), pct(worst, n_acc), ", ".join(misses) or "none"))
+            fa, fr, pct(fr, sum(ok)), pct(worst, len(acc)), ", ".join(misses) or "none"))
 
 
 def plot(out, path, label):

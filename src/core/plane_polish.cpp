@@ -381,10 +381,9 @@ PolishResult polishOnPlanes(const PlaneMap& map, const PointArray& scan, const P
     res.reason = "too few points near a reference plane";
     return res;
   }
-  const double shift_m = (t - T0.translation()).norm();
-  const double shift_rad = rotationAngle(R * T0.linear().transpose());
-  res.shift_m = shift_m, res.shift_rad = shift_rad;
-  if (!(shift_m <= s.max_shift_m) || !(shift_rad <= s.max_shift_rad)) {
+  res.shift_m = (t - T0.translation()).norm();
+  res.shift_rad = rotationAngle(R * T0.linear().transpose());
+  if (!(res.shift_m <= s.max_shift_m) || !(res.shift_rad <= s.max_shift_rad)) {
     res.reason = "the polish left the cube result's basin";
     return res;
   }
