@@ -22,6 +22,7 @@ std::string toString(GateReason reason) {
     case GateReason::Degenerate: return "degenerate";
     case GateReason::Uncertain: return "uncertain";
     case GateReason::Ambiguous: return "ambiguous";
+    case GateReason::NonFinite: return "non_finite";
   }
   return "unknown";
 }

@@ -54,6 +54,7 @@ std::size_t OnlineMatcher::keyframeBytes() const {
 }
 
 void OnlineMatcher::restartAt(const Eigen::Isometry3d& pose) {
+  if (!isRigid(pose)) throw std::invalid_argument("restartAt: the pose is not a finite rigid motion");
   reset();
   start_pose_ = pose;
 }
@@ -168,13 +169,20 @@ void OnlineMatcher::deskewScan(OnlineStep& step, const PointArray& points,
 }
 
 OnlineStep OnlineMatcher::process(const PointArray& scan_points, double stamp,
-                                  const std::optional<Eigen::Isometry3d>& odom,
+                                  const std::optional<Eigen::Isometry3d>& given_odom,
                                   const PointTimes* times) {
   if (times && times->tau.size() != scan_points.size()) {
     throw std::invalid_argument("process: " + std::to_string(times->tau.size()) +
                                 " point times for " + std::to_string(scan_points.size()) + " points");
   }
+  if (!std::isfinite(stamp)) throw std::invalid_argument("process: the scan's stamp is not finite");
   OnlineStep step;
+  // Odometry with a NaN or infinite value (a broken driver) is no odometry.
+  std::optional<Eigen::Isometry3d> odom = given_odom;
+  if (odom && !isRigid(*odom)) {
+    odom.reset();
+    step.message = "odometry pose not finite or not a rotation: ignored";
+  }
   // The scan's points, re-placed below when de-skewed (a copy only then).
   std::optional<PointArray> deskewed;
   const PointArray* points_ptr = &scan_points;
@@ -262,8 +270,22 @@ OnlineStep OnlineMatcher::process(const PointArray& scan_points, double stamp,
       points_ptr = &*deskewed;
     }
   }
-  if (keyframe) step.pose = keyframe->pose * step.increment;
+  // A rejected scan is placed at the prediction itself: keyframe * (keyframe^-1 * predicted)
+  // would multiply the keyframe's rounding error into the pose, and a chain of forced scans
+  // (each the next one's keyframe) would grow it threefold per scan until the pose is NaN.
+  if (keyframe) step.pose = step.accepted ? keyframe->pose * step.increment : predicted;
   const PointArray& points = *points_ptr;
+  // The chain guard: a pose that is not a finite rigid motion never enters the chain, the
+  // prediction or a published message; the scan is refused and the last pose kept.
+  const bool refused = !isRigid(step.pose);
+  if (refused) {
+    step.reason = GateReason::NonFinite;
+    step.accepted = false;
+    step.pose = last_known_ ? last_known_->pose : last_pose_;
+    step.increment = keyframe ? keyframe->pose.inverse() * step.pose : Eigen::Isometry3d::Identity();
+    if (!step.message.empty()) step.message += "; ";
+    step.message += "the step's pose is not a finite rigid motion: refused, the last pose kept";
+  }
 
   const bool rejected = !first && !step.accepted;
   consecutive_rejections_ = rejected ? consecutive_rejections_ + 1 : 0;
@@ -271,12 +293,13 @@ OnlineStep OnlineMatcher::process(const PointArray& scan_points, double stamp,
   step.rejection_alarm = consecutive_rejections_ >= settings_.max_consecutive_rejections;
 
   // A known pose (first, accepted, or forced on by the alarm) predicts the next scans.
-  const bool known = first || step.accepted || (step.rejection_alarm && !points.empty());
+  const bool known = !refused && (first || step.accepted || (step.rejection_alarm && !points.empty()));
   if (known && !points.empty()) {
     if (last_known_ && stamp > last_known_->stamp) {
       step.motion = last_known_->pose.inverse() * step.pose;
       step.interval = stamp - last_known_->stamp;
-      velocity_ = isometryToPose(step.motion) / step.interval;
+      const Pose6 velocity = isometryToPose(step.motion) / step.interval;
+      if (velocity.allFinite()) velocity_ = velocity;
     }
     // A new keyframe: the first scan, a forced one, or an accepted scan far enough from the
     // keyframe (never a rejected one).
@@ -301,7 +324,7 @@ OnlineStep OnlineMatcher::process(const PointArray& scan_points, double stamp,
       if (odom) anchor_ = last_known_;
       if (first) start_pose_.reset();
     }
-  } else if (rejected && !points.empty()) {
+  } else if (rejected && !points.empty() && !refused) {
     if (!step.message.empty()) step.message += "; ";
     step.message += "scan not used as reference: the registration was rejected";
   }

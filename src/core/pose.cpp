@@ -46,6 +46,13 @@ Pose6 isometryToPose(const Eigen::Isometry3d& transform) {
   return pose;
 }
 
+bool isRigid(const Eigen::Isometry3d& transform, double tolerance) {
+  if (!transform.matrix().allFinite()) return false;
+  const Eigen::Matrix3d& r = transform.linear();
+  return (r.transpose() * r - Eigen::Matrix3d::Identity()).cwiseAbs().maxCoeff() <= tolerance &&
+         std::abs(r.determinant() - 1.0) <= tolerance;
+}
+
 double wrapAngle(double angle) {
   angle = std::remainder(angle, 2.0 * M_PI);
   return angle <= -M_PI ? angle + 2.0 * M_PI : angle;

@@ -82,6 +82,8 @@ void waitForSubscriber(const ros::Publisher& pub, const Common& c) {
 void runSweeps(ros::NodeHandle& nh, ros::NodeHandle& pnh, const Common& c) {
   const double period = readParam(pnh, "period", 1.0, 0.05, 3600.0);
   const bool organized = pnh.param("organized", false);
+  // Odometry (odom -> base_link) for the first N sweeps only, then none: a lost odometry.
+  const int odometry_sweeps = readParam(pnh, "odometry_sweeps", 0, 0, 1 << 30);  // 0 = all
   sim::MotionSettings motion;
   motion.step_min = readParam(pnh, "step_min", motion.step_min, 0.0, 20.0);
   motion.step_max = readParam(pnh, "step_max", motion.step_max, motion.step_min, 20.0);
@@ -127,8 +129,13 @@ void runSweeps(ros::NodeHandle& nh, ros::NodeHandle& pnh, const Common& c) {
     {
       std::lock_guard<std::mutex> lock(odom_mutex);
       stamp = ros::Time::now();
-      last_odom = odom;
-      tf_pub.sendTransform(stampedTransform(odom, c.odom_frame, c.base_frame, stamp));
+      if (odometry_sweeps == 0 || k < odometry_sweeps) {
+        last_odom = odom;
+        tf_pub.sendTransform(stampedTransform(odom, c.odom_frame, c.base_frame, stamp));
+      } else {
+        if (k == odometry_sweeps) ROS_WARN("simulator: odometry tf stops at sweep %d (~odometry_sweeps)", k);
+        last_odom.reset();
+      }
     }
     publishTruth(truth_pub, truth, c.map_frame, stamp);
     ros::WallDuration(0.02).sleep();  // tf first, then the cloud that needs it
@@ -381,7 +388,8 @@ int main(int argc, char** argv) {
     c.mount.translation() = Eigen::Vector3d(0.1, 0.0, 0.4);  // scanner 0.4 m above base_link
     // Parameters of the other input are not read: say so rather than ignore them silently.
     const std::vector<std::string> other =
-        input == "lines" ? std::vector<std::string>{"period", "organized", "step_min", "step_max", "yaw_change_max"}
+        input == "lines" ? std::vector<std::string>{"period", "organized", "step_min", "step_max", "yaw_change_max",
+                                                            "odometry_sweeps"}
                          : std::vector<std::string>{"line_rate", "speed", "yaw_rate", "mount_frame"};
     for (const std::string& name : other) {
       if (pnh.hasParam(name)) ROS_WARN("simulator: ~%s is not used with input %s", name.c_str(), input.c_str());

@@ -2,6 +2,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <limits>
 #include <random>
 
 #include "cube_scan_matcher/core/online_matcher.h"
@@ -343,4 +344,72 @@ TEST(OnlineMatcher, PointTimesOfTheWrongSizeAreRefusedAndEqualTimesAreRigid) {
   const OnlineStep step = m.process(scan, 2.0, b, &same);
   EXPECT_TRUE(step.accepted) << step.message;
   EXPECT_FALSE(step.deskewed);
+}
+
+namespace {
+
+/// A 10 m block of random points around x = `x` [m] in the base frame.
+PointArray blockAt(double x, std::mt19937_64& rng) {
+  std::uniform_real_distribution<float> u(-5.0f, 5.0f);
+  PointArray p;
+  for (int i = 0; i < 2000; ++i) p.push_back(float(x) + u(rng), u(rng), u(rng));
+  return p;
+}
+
+bool finite(const OnlineStep& s) {
+  return s.pose.matrix().allFinite() && s.increment.matrix().allFinite() &&
+         s.motion.matrix().allFinite() && s.guess.allFinite() && s.correction.allFinite();
+}
+
+}  // namespace
+
+// Without odometry, scans that never register (no overlap) are forced on after
+// max_consecutive_rejections, each the next one's keyframe. The chain starts at a turned pose:
+// its rounding must not grow from forced scan to forced scan until the pose is NaN.
+TEST(OnlineMatcher, ForcedScansWithoutOdometryKeepTheChainFiniteAndRigid) {
+  std::mt19937_64 rng(11);
+  OnlineMatcher m{OnlineMatcherSettings{}};
+  Eigen::Isometry3d start = Eigen::Isometry3d::Identity();
+  start.linear() = rotationFromRpy(deg2rad(3.0), deg2rad(-4.0), deg2rad(37.0));
+  start.translation() = Eigen::Vector3d(12.0, -7.0, 1.5);
+  m.restartAt(start);
+  constexpr int kScans = 80;
+  for (int k = 0; k < kScans; ++k) {
+    // Each scan's points lie 100 m beyond the last one's: nothing overlaps.
+    const OnlineStep s = m.process(blockAt(100.0 * k, rng), 1.0 * k, std::nullopt);
+    ASSERT_TRUE(finite(s)) << "scan " << k << ": " << s.message;
+    ASSERT_TRUE(isRigid(s.pose, 1e-9)) << "scan " << k << ": rotation drifted from orthonormal";
+    if (k == 0) continue;
+    EXPECT_FALSE(s.accepted) << "scan " << k;
+    EXPECT_EQ(s.rejection_alarm, k >= OnlineMatcherSettings{}.max_consecutive_rejections) << "scan " << k;
+    // No motion was ever registered: a forced scan stays where the chain started.
+    EXPECT_LT((s.pose.translation() - start.translation()).norm(), 1e-6) << "scan " << k;
+  }
+}
+
+// A step whose pose would not be finite never enters the chain: odometry with a NaN is ignored
+// (the scan is registered as without odometry), and a start pose with one is refused.
+TEST(OnlineMatcher, NonFiniteOdometryIsIgnoredAndANonFiniteStartIsRefused) {
+  const sim::Scene scene = sim::Scene::generate(sim::SceneType::Hall, 2);
+  std::mt19937_64 rng(3);
+  Eigen::Isometry3d body = Eigen::Isometry3d::Identity();
+  body.translation() = Eigen::Vector3d(2, 0.5, 1.0);
+  const PointArray scan = scanInBase(scene, body, rng);
+  OnlineMatcher m{OnlineMatcherSettings{}};
+  Eigen::Isometry3d bad = Eigen::Isometry3d::Identity();
+  bad.translation().x() = std::numeric_limits<double>::quiet_NaN();
+  EXPECT_THROW(m.restartAt(bad), std::invalid_argument);
+  EXPECT_THROW(m.process(scan, std::numeric_limits<double>::infinity(), std::nullopt),
+               std::invalid_argument);
+
+  OnlineStep s = m.process(scan, 1.0, bad);
+  EXPECT_EQ(s.reason, GateReason::FirstScan);
+  EXPECT_TRUE(s.pose.isApprox(Eigen::Isometry3d::Identity())) << "the NaN odometry was used";
+  EXPECT_NE(s.message.find("odometry pose not finite"), std::string::npos) << s.message;
+  Eigen::Isometry3d sheared = Eigen::Isometry3d::Identity();
+  sheared.linear()(0, 1) = 0.5;  // not a rotation
+  s = m.process(scan, 2.0, sheared);
+  EXPECT_FALSE(s.odometry_guess);
+  EXPECT_EQ(s.reason, GateReason::Accepted) << s.message;
+  EXPECT_TRUE(finite(s));
 }

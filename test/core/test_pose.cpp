@@ -1,5 +1,6 @@
 #include <gtest/gtest.h>
 
+#include <limits>
 #include <random>
 
 #include "cube_scan_matcher/core/pose.h"
@@ -46,4 +47,18 @@ TEST(Pose, WrapAngle) {
   EXPECT_NEAR(wrapAngle(3 * M_PI / 2), -M_PI / 2, 1e-12);
   EXPECT_NEAR(wrapAngle(-M_PI), M_PI, 1e-12);
   EXPECT_NEAR(wrapAngle(0.25), 0.25, 1e-15);
+}
+
+TEST(Pose, IsRigidTellsARotationFromAScaledOrMirroredOne) {
+  Eigen::Isometry3d t = poseToIsometry((Pose6() << 1, -2, 3, 0.3, -0.2, 2.9).finished());
+  EXPECT_TRUE(isRigid(t, 1e-12));
+  Eigen::Isometry3d bent = t;
+  bent.linear() *= 1.0 + 1e-5;  // a scaled rotation
+  EXPECT_FALSE(isRigid(bent));
+  EXPECT_TRUE(isRigid(bent, 1e-4));
+  Eigen::Isometry3d mirrored = t;
+  mirrored.linear().col(0) *= -1.0;  // orthonormal, det -1
+  EXPECT_FALSE(isRigid(mirrored));
+  t.translation().y() = std::numeric_limits<double>::infinity();
+  EXPECT_FALSE(isRigid(t));
 }

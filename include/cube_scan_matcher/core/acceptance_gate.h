@@ -25,6 +25,9 @@ enum class GateReason : std::uint8_t {
   Degenerate = 10,  ///< a direction of the result has (almost) no information.
   Uncertain = 11,   ///< the result's covariance is too wide.
   Ambiguous = 12,   ///< weakly fixed, the starts disagree, and no retry landed on it again.
+  /// The step would put a NaN, infinite or non-rigid pose into the chain: refused, the chain
+  /// keeps its last known pose (OnlineMatcher::process).
+  NonFinite = 13,
 };
 std::string toString(GateReason reason);
 

@@ -124,8 +124,11 @@ class OnlineMatcher {
   /// time the prediction spans, in whole scan periods: see OnlineStep::gate_scale.
   /// `times` (optional): each point's time relative to `stamp` and how the points were placed
   /// (PointTimes). With settings().deskew.enabled an accepted scan is re-placed with the
-  /// registered motion (DeskewSettings), and the keyframe keeps the re-placed points. Throws
-  /// std::invalid_argument if times->tau has the wrong size.
+  /// registered motion (DeskewSettings), and the keyframe keeps the re-placed points.
+  /// No NaN or infinite value enters the chain: odometry that is not a finite rigid motion is
+  /// ignored (as if missing), and a step whose pose would not be one is refused
+  /// (GateReason::NonFinite; the pose stays at the last known one). Throws
+  /// std::invalid_argument if times->tau has the wrong size or `stamp` is not finite.
   OnlineStep process(const PointArray& points, double stamp,
                      const std::optional<Eigen::Isometry3d>& odom,
                      const PointTimes* times = nullptr);
@@ -133,7 +136,8 @@ class OnlineMatcher {
   /// Forgets the reference, the pose chain and the rejection count.
   void reset();
   /// reset(), and the next scan starts the new chain at `pose` (T_map_base) instead of its
-  /// odometry pose.
+  /// odometry pose. Throws std::invalid_argument (and changes nothing) if `pose` is not a
+  /// finite rigid motion.
   void restartAt(const Eigen::Isometry3d& pose);
   /// Takes effect at the next scan. Validates, and rebuilds the current reference's grids with
   /// the new settings at once: throws std::invalid_argument (and keeps the old settings) when

@@ -24,6 +24,11 @@ Eigen::Isometry3d poseToIsometry(const Pose6& pose);
 /// (|pitch| = 90 deg) roll is set to 0 and yaw absorbs the rest.
 Pose6 isometryToPose(const Eigen::Isometry3d& transform);
 
+/// Whether `transform` is a rigid motion: every entry finite and its linear part a rotation
+/// (R^T R = I and det R = +1, each within `tolerance`). Products of many rigid transforms drift
+/// from it by rounding; a pose chain that stays within 1e-6 of it is sound.
+bool isRigid(const Eigen::Isometry3d& transform, double tolerance = 1e-6);
+
 /// Wraps an angle to (-pi, pi].
 double wrapAngle(double angle);
 
