@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Portable build check (issue 13): compiles every ROS-free source (core, simulator, io) for
+# Portable build check: compiles every ROS-free source (core, simulator, io) for
 # aarch64 with Debian's cross compiler, to object code (-O2 -c: GCC reports a bad target
 # attribute only at code generation), with the package's warnings as errors. The x86-only
 # function clones of the hot loop must stay behind their guard.

@@ -11,7 +11,7 @@ usage: /usr/bin/python3 scripts/plot_scenes.py OUT.png SCENES.csv [LABEL]
 axis's errors beyond 3 predicted standard deviations, and the smallest factor on the
 covariance (covariance_scale, relative to the run's) that brings every axis to <= 1 %.
 
---targets: issue 12's targets per scene type, the CSVs pooled: successes from the big starts
+--targets: the scene benchmark's targets per scene type, the CSVs pooled: successes from the big starts
 (>= 99.5 %) and from all; median / p95 Es and Ea of the accepted results (<= 2 cm, 0.1 deg /
 5 cm, 0.3 deg); false accepts (0); false rejects as a share of the right results (<= 1 %); the
 accepted results' worst axis beyond 3 predicted sd (<= 1 %); and the targets each type misses.

@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# The nodelet at robot rates (issue 14; a benchmark, not a test): rate_feeder publishes
+# The nodelet at robot rates (a benchmark, not a test): rate_feeder publishes
 # simulated 65k-point sweeps with fresh stamps at RATE Hz for SECONDS s into the scan matcher
 # nodelet in its own manager (launch/scan_matcher.launch, config/scan_matcher.yaml), and
 # prints the data age (stamp -> published pose), latency, registration time, drops and the

@@ -168,6 +168,22 @@ void OnlineMatcher::deskewScan(OnlineStep& step, const PointArray& points,
   step.deskewed = true;
 }
 
+namespace {
+
+void appendMessage(OnlineStep& step, const std::string& text) {
+  if (!step.message.empty()) step.message += "; ";
+  step.message += text;
+}
+
+/// Whether the points were taken over time (their times differ): only such a scan is de-skewed.
+bool takenOverTime(const PointTimes* times) {
+  if (!times || times->tau.empty()) return false;
+  const auto [lo, hi] = std::minmax_element(times->tau.begin(), times->tau.end());
+  return *hi - *lo > 1e-6f;
+}
+
+}  // namespace
+
 OnlineStep OnlineMatcher::process(const PointArray& scan_points, double stamp,
                                   const std::optional<Eigen::Isometry3d>& given_odom,
                                   const PointTimes* times) {
@@ -177,15 +193,44 @@ OnlineStep OnlineMatcher::process(const PointArray& scan_points, double stamp,
   }
   if (!std::isfinite(stamp)) throw std::invalid_argument("process: the scan's stamp is not finite");
   OnlineStep step;
-  // Odometry with a NaN or infinite value (a broken driver) is no odometry.
-  std::optional<Eigen::Isometry3d> odom = given_odom;
-  if (odom && !isRigid(*odom)) {
-    odom.reset();
-    step.message = "odometry pose not finite or not a rotation: ignored";
+  const std::optional<Eigen::Isometry3d> odom = usableOdometry(given_odom, step);
+  trackTime(stamp, step);
+  const Twist placed = placedVelocity(stamp, odom, times);
+  const bool first = keyframes_.empty();
+  const Prediction predicted = predict(stamp, odom, step);
+  const Keyframe* keyframe = first ? nullptr : &keyframes_.back();
+  std::optional<PointArray> deskewed;  // the scan re-placed with the registered motion
+  if (first) {
+    step.reason = scan_points.empty() ? GateReason::BadInput : GateReason::FirstScan;
+    step.pose = predicted.pose;
+  } else if (scan_points.empty()) {
+    step.reason = GateReason::BadInput;
+  } else {
+    registerAndGate(step, scan_points, stamp, predicted.from, *keyframe);
+    if (step.accepted && takenOverTime(times) && settings_.deskew.enabled && last_known_ &&
+        stamp > last_known_->stamp) {
+      deskewScan(step, scan_points, *times, stamp - last_known_->stamp, placed, *keyframe,
+                 scaledGate(step.gate_scale), deskewed);
+    }
   }
-  // The scan's points, re-placed below when de-skewed (a copy only then).
-  std::optional<PointArray> deskewed;
-  const PointArray* points_ptr = &scan_points;
+  const bool refused = !placeScan(step, keyframe, predicted.pose);
+  countRejections(step, first);
+  updateChain(step, deskewed ? *deskewed : scan_points, stamp, odom, keyframe, first, refused);
+  describe(step);
+  return step;
+}
+
+std::optional<Eigen::Isometry3d> OnlineMatcher::usableOdometry(
+    const std::optional<Eigen::Isometry3d>& odom, OnlineStep& step) {
+  // Odometry with a NaN or infinite value (a broken driver) is no odometry.
+  if (odom && !isRigid(*odom)) {
+    appendMessage(step, "odometry pose not finite or not a rotation: ignored");
+    return std::nullopt;
+  }
+  return odom;
+}
+
+void OnlineMatcher::trackTime(double stamp, OnlineStep& step) {
   if (last_stamp_ && stamp < *last_stamp_) {
     // The scan period is the sensor's: it survives a bag loop or a clock reset.
     std::deque<double> intervals = std::move(intervals_);
@@ -198,100 +243,108 @@ OnlineStep OnlineMatcher::process(const PointArray& scan_points, double stamp,
     if (intervals_.size() > kIntervals) intervals_.pop_front();
   }
   last_stamp_ = stamp;
+}
+
+Twist OnlineMatcher::placedVelocity(double stamp, const std::optional<Eigen::Isometry3d>& odom,
+                                    const PointTimes* times) {
   // The velocity the odometry placed this scan's points with: its motion since the previous
   // scan (whatever became of that one), at constant velocity (core/deskew.h).
-  Twist placed_velocity = Twist::Zero();
+  Twist placed = Twist::Zero();
   if (times && times->placed_by_odometry && odom && previous_odom_ && stamp > previous_odom_->stamp) {
-    placed_velocity = velocityOf(previous_odom_->odom->inverse() * *odom, stamp - previous_odom_->stamp);
+    placed = velocityOf(previous_odom_->odom->inverse() * *odom, stamp - previous_odom_->stamp);
   }
   if (odom) previous_odom_ = Known{Eigen::Isometry3d::Identity(), odom, stamp};
-  const bool first = keyframes_.empty();
-  // The predicted pose T_map_base: odometry from the anchor, else no motion since the last
-  // known pose.
-  step.odometry_guess = !first && odom && anchor_;
-  Eigen::Isometry3d predicted = start_pose_ ? *start_pose_ : odom ? *odom : Eigen::Isometry3d::Identity();
-  double predicted_from = stamp;
-  if (step.odometry_guess) {
-    predicted = anchor_->pose * anchor_->odom->inverse() * *odom;
-    predicted_from = anchor_->stamp;
-  } else if (!first && last_known_) {
-    predicted = last_known_->pose;
-    if (settings_.constant_velocity) {
-      predicted = predicted * poseToIsometry(velocity_ * (stamp - last_known_->stamp));
-    }
-    predicted_from = last_known_->stamp;
-  }
-  const Keyframe* keyframe = first ? nullptr : &keyframes_.back();
-  if (keyframe) step.increment = keyframe->pose.inverse() * predicted;
-  step.guess = isometryToPose(step.increment);
+  return placed;
+}
 
-  if (first) {
-    step.reason = scan_points.empty() ? GateReason::BadInput : GateReason::FirstScan;
-    step.pose = predicted;
-  } else if (scan_points.empty()) {
-    step.reason = GateReason::BadInput;
-  } else {
-    step.registered = true;
-    step.gate_scale = gateScale(stamp, predicted_from);
-    if (!step.odometry_guess) step.gate_scale = std::max(step.gate_scale, settings_.no_odometry_scale);
-    // The guess spans several increments, or has no odometry: search as much wider as the
-    // gate is.
-    RegistrationSettings wide = settings_.registration;
-    wide.gnmm.bounds *= step.gate_scale;
-    if (step.gate_scale > 1.0) registration_.setSettings(wide);
-    step.result = registration_.align(scan_points, step.guess);
-    if (!step.odometry_guess && settings_.constant_velocity && settings_.no_motion_candidate &&
-        last_known_) {
-      // Constant velocity fails where the motion changes most (a turn on the spot that starts,
-      // stops or reverses): the no-motion guess is searched too, and the higher J wins.
-      const Pose6 still = isometryToPose(keyframe->pose.inverse() * last_known_->pose);
-      if ((still - step.guess).norm() > 1e-6) {
-        RegistrationResult other = registration_.align(scan_points, still);
-        if (other.ok() && (!step.result.ok() || other.J > step.result.J)) {
-          step.result = std::move(other);
-          step.guess = still;
-        }
+OnlineMatcher::Prediction OnlineMatcher::predict(double stamp,
+                                                 const std::optional<Eigen::Isometry3d>& odom,
+                                                 OnlineStep& step) const {
+  // The predicted pose T_map_base: the first scan's start pose or odometry; then the odometry
+  // increment from the anchor, else the last known pose moved on at the last registered
+  // velocity (constant_velocity) or not moved.
+  const bool first = keyframes_.empty();
+  step.odometry_guess = !first && odom && anchor_;
+  Prediction p{start_pose_ ? *start_pose_ : odom ? *odom : Eigen::Isometry3d::Identity(), stamp};
+  if (step.odometry_guess) {
+    p.pose = anchor_->pose * anchor_->odom->inverse() * *odom;
+    p.from = anchor_->stamp;
+  } else if (!first && last_known_) {
+    p.pose = last_known_->pose;
+    if (settings_.constant_velocity) {
+      p.pose = p.pose * poseToIsometry(velocity_ * (stamp - last_known_->stamp));
+    }
+    p.from = last_known_->stamp;
+  }
+  if (!first) step.increment = keyframes_.back().pose.inverse() * p.pose;
+  step.guess = isometryToPose(step.increment);
+  return p;
+}
+
+GateSettings OnlineMatcher::scaledGate(double gate_scale) const {
+  GateSettings g = settings_.gate;
+  g.max_correction_m *= gate_scale;
+  g.max_correction_rad *= gate_scale;
+  return g;
+}
+
+void OnlineMatcher::registerAndGate(OnlineStep& step, const PointArray& points, double stamp,
+                                    double predicted_from, const Keyframe& keyframe) {
+  step.registered = true;
+  step.gate_scale = gateScale(stamp, predicted_from);
+  if (!step.odometry_guess) step.gate_scale = std::max(step.gate_scale, settings_.no_odometry_scale);
+  // The guess spans several increments, or has no odometry: search as much wider as the gate is.
+  RegistrationSettings wide = settings_.registration;
+  wide.gnmm.bounds *= step.gate_scale;
+  if (step.gate_scale > 1.0) registration_.setSettings(wide);
+  step.result = registration_.align(points, step.guess);
+  if (!step.odometry_guess && settings_.constant_velocity && settings_.no_motion_candidate &&
+      last_known_) {
+    // Constant velocity fails where the motion changes most (a turn on the spot that starts,
+    // stops or reverses): the no-motion guess is searched too, and the higher J wins.
+    const Pose6 still = isometryToPose(keyframe.pose.inverse() * last_known_->pose);
+    if ((still - step.guess).norm() > 1e-6) {
+      RegistrationResult other = registration_.align(points, still);
+      if (other.ok() && (!step.result.ok() || other.J > step.result.J)) {
+        step.result = std::move(other);
+        step.guess = still;
       }
     }
-    if (step.gate_scale > 1.0) registration_.setSettings(settings_.registration);
-    GateSettings gate_settings = settings_.gate;
-    gate_settings.max_correction_m *= step.gate_scale;
-    gate_settings.max_correction_rad *= step.gate_scale;
-    step.reason = gate(step.result, step.guess, gate_settings);
-    if (step.result.ok()) step.correction = correctionFromGuess(step.guess, step.result.pose);
-    step.accepted = step.reason == GateReason::Accepted;
-    if (step.accepted) step.increment = step.result.transform;
-    const bool spread = times && !times->tau.empty() && [&] {
-      const auto [lo, hi] = std::minmax_element(times->tau.begin(), times->tau.end());
-      return *hi - *lo > 1e-6f;
-    }();
-    if (step.accepted && spread && settings_.deskew.enabled && last_known_ && stamp > last_known_->stamp) {
-      deskewScan(step, scan_points, *times, stamp - last_known_->stamp, placed_velocity, *keyframe, gate_settings, deskewed);
-      points_ptr = &*deskewed;
-    }
   }
+  if (step.gate_scale > 1.0) registration_.setSettings(settings_.registration);
+  step.reason = gate(step.result, step.guess, scaledGate(step.gate_scale));
+  if (step.result.ok()) step.correction = correctionFromGuess(step.guess, step.result.pose);
+  step.accepted = step.reason == GateReason::Accepted;
+  if (step.accepted) step.increment = step.result.transform;
+}
+
+bool OnlineMatcher::placeScan(OnlineStep& step, const Keyframe* keyframe,
+                              const Eigen::Isometry3d& predicted) {
   // A rejected scan is placed at the prediction itself: keyframe * (keyframe^-1 * predicted)
   // would multiply the keyframe's rounding error into the pose, and a chain of forced scans
   // (each the next one's keyframe) would grow it threefold per scan until the pose is NaN.
   if (keyframe) step.pose = step.accepted ? keyframe->pose * step.increment : predicted;
-  const PointArray& points = *points_ptr;
   // The chain guard: a pose that is not a finite rigid motion never enters the chain, the
   // prediction or a published message; the scan is refused and the last pose kept.
-  const bool refused = !isRigid(step.pose);
-  if (refused) {
-    step.reason = GateReason::NonFinite;
-    step.accepted = false;
-    step.pose = last_known_ ? last_known_->pose : last_pose_;
-    step.increment = keyframe ? keyframe->pose.inverse() * step.pose : Eigen::Isometry3d::Identity();
-    if (!step.message.empty()) step.message += "; ";
-    step.message += "the step's pose is not a finite rigid motion: refused, the last pose kept";
-  }
+  if (isRigid(step.pose)) return true;
+  step.reason = GateReason::NonFinite;
+  step.accepted = false;
+  step.pose = last_known_ ? last_known_->pose : last_pose_;
+  step.increment = keyframe ? keyframe->pose.inverse() * step.pose : Eigen::Isometry3d::Identity();
+  appendMessage(step, "the step's pose is not a finite rigid motion: refused, the last pose kept");
+  return false;
+}
 
+void OnlineMatcher::countRejections(OnlineStep& step, bool first) {
   const bool rejected = !first && !step.accepted;
   consecutive_rejections_ = rejected ? consecutive_rejections_ + 1 : 0;
   step.consecutive_rejections = consecutive_rejections_;
   step.rejection_alarm = consecutive_rejections_ >= settings_.max_consecutive_rejections;
+}
 
+void OnlineMatcher::updateChain(OnlineStep& step, const PointArray& points, double stamp,
+                                const std::optional<Eigen::Isometry3d>& odom,
+                                const Keyframe* keyframe, bool first, bool refused) {
   // A known pose (first, accepted, or forced on by the alarm) predicts the next scans.
   const bool known = !refused && (first || step.accepted || (step.rejection_alarm && !points.empty()));
   if (known && !points.empty()) {
@@ -314,8 +367,7 @@ OnlineStep OnlineMatcher::process(const PointArray& scan_points, double stamp,
     std::string why;
     if (new_keyframe && !addKeyframe(points, step.pose, stamp, why)) {
       if (first) step.reason = GateReason::BadReference;
-      if (!step.message.empty()) step.message += "; ";
-      step.message += "scan not used as reference: " + why;
+      appendMessage(step, "scan not used as reference: " + why);
     } else {
       step.reference_updated = new_keyframe;
     }
@@ -324,13 +376,14 @@ OnlineStep OnlineMatcher::process(const PointArray& scan_points, double stamp,
       if (odom) anchor_ = last_known_;
       if (first) start_pose_.reset();
     }
-  } else if (rejected && !points.empty() && !refused) {
-    if (!step.message.empty()) step.message += "; ";
-    step.message += "scan not used as reference: the registration was rejected";
+  } else if (!first && !step.accepted && !points.empty() && !refused) {
+    appendMessage(step, "scan not used as reference: the registration was rejected");
   }
   step.keyframes = int(keyframes_.size());  // at most submap_size: addKeyframe(), setSettings()
   last_pose_ = step.pose;
+}
 
+void OnlineMatcher::describe(OnlineStep& step) {
   std::ostringstream os;
   os << toString(step.reason);
   if (step.registered) os << " (" << step.result.message << ")";
@@ -341,7 +394,6 @@ OnlineStep OnlineMatcher::process(const PointArray& scan_points, double stamp,
   }
   if (!step.message.empty()) os << "; " << step.message;
   step.message = os.str();
-  return step;
 }
 
 }  // namespace cube_scan_matcher

@@ -1,4 +1,4 @@
-// rate_feeder: the nodelet at robot rates (issue 14). Simulates `distinct` organised sweeps
+// rate_feeder: the nodelet at robot rates. Simulates `distinct` organised sweeps
 // (361 x 181 = 65,341 points each, NaN for no return) along a driven path sampled at the feed
 // rate, then publishes them at `rate` [Hz] for `duration` [s] with fresh stamps, driving
 // forward along the path and back (so the motion stays continuous and time never goes back,

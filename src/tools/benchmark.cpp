@@ -214,7 +214,7 @@ int main(int argc, char** argv) {
           s.grid.cube_edge = e;
           addCube(label.str(), s);
         } else if (m == "cubes-nopolish") {
-          RegistrationSettings s;  // session 7's defaults, not the command line's cube options
+          RegistrationSettings s;  // the defaults before the polish, not the command line's cube options
           s.refine.compass.levels = 5;
           s.grid.cube_edge = e;
           s.polish.enabled = false;

@@ -1,4 +1,4 @@
-// Open3D peers of the sequence and pair benchmarks (issue 13): point-to-plane ICP and
+// Open3D peers of the sequence and pair benchmarks: point-to-plane ICP and
 // generalized ICP from Debian's libopen3d-dev 0.16, with the same signature as the PCL peers
 // (peer_methods.h) so the benchmarks chain them the same way. Built only when Open3D is found;
 // open3dAvailable() says whether this build has them.

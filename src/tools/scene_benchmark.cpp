@@ -1,4 +1,4 @@
-// scene_benchmark: pairwise registration over many simulated worlds with exact truth (issue 12).
+// scene_benchmark: pairwise registration over many simulated worlds with exact truth.
 // Per trial: a seeded world of a scene type, a start pose on its street, a motion (the paper's
 // Table 1 motion of that scene type, or a random 1-5 m / +-45 deg motion), two sweeps of the
 // simulated tilting scanner, and registrations from guesses = truth with uniform errors within

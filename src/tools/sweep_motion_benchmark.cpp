@@ -1,4 +1,4 @@
-// sweep_motion_benchmark: registration of sweeps taken while the robot drives (issue 15).
+// sweep_motion_benchmark: registration of sweeps taken while the robot drives.
 // Per trial: a seeded world, a zigzag path at a given speed and yaw rate (sim::DrivenPath, the
 // yaw rate flipping every sweep), and a run of sweeps taken back to back (each sweep lasts
 // `duration` [s], so a sweep's interval is its duration; the tilt goes up, then down). Each

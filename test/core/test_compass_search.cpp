@@ -32,7 +32,7 @@ TEST(CompassSearch, RespectsTheEvaluationBudgetAndValidates) {
 }
 
 namespace {
-// The search as first written (session 2): every pass polls the 12 directions from direction 0
+// The search as first written: every pass polls the 12 directions from direction 0
 // again, and a level ends after a pass without a move. Kept here as the reference the cyclic
 // poll must follow move for move.
 CompassResult restartingPasses(const Objective6& f, const Vector6d& initial,

@@ -222,7 +222,7 @@ TEST(OnlineMatcher, StandingStillAddsNoDriftWithKeyframes) {
     EXPECT_EQ(s.reason, k == 0 ? GateReason::FirstScan : GateReason::Accepted) << s.message;
     EXPECT_EQ(s.reference_updated, k == 0) << "scan " << k;
     EXPECT_EQ(s.keyframes, 1);
-    // One registration's error (issue 12's scatter), not a sum over the scans.
+    // One registration's error (the scene benchmark's scatter), not a sum over the scans.
     EXPECT_LT(translationError(s.pose, first_pose), 0.05) << "scan " << k;
   }
 }

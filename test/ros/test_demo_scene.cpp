@@ -57,9 +57,9 @@ TEST(DemoScene, EveryIncrementMatchesTheTruth) {
   EXPECT_GE(lookups, 8);
   // A miss in 20 is tolerated (at least one): on this 2-core machine, with the simulator, the
   // manager and a registration's two search threads sharing the cores, one lookup in 65 has
-  // been seen to find the chain's latest data 22 ms short of now after the full tf_wait, and
-  // (session 20, with the manager's default 2 worker threads, one held by the registration) two
-  // in 65 up to 0.42 s short. The launch file now gives its manager 4 worker threads.
+  // been seen to find the chain's latest data 22 ms short of now after the full tf_wait (with the
+  // manager's default 2 worker threads, one held by the registration, two in 65 were up to 0.42 s
+  // short: the launch file gives its manager 4 worker threads).
   EXPECT_GE(lookups_ok, lookups - std::max(1, lookups / 20)) << "last error: " << lookup_error;
   for (const auto& r : evaluator.rows()) {
     EXPECT_GT(evaluator.cloudPoints(r.stamp), 1000u) << "sweep " << r.sweep << ": no registered_cloud";

@@ -1,5 +1,5 @@
-// Where a sweep of a tilting 2D laser ends: the sweep cutter of SweepAssemblerNodelet (issue 15,
-// part 2). ROS-free: it sees one (time, tilt angle) pair per scan line, in arrival order, and
+// Where a sweep of a tilting 2D laser ends: the sweep cutter of SweepAssemblerNodelet.
+// ROS-free: it sees one (time, tilt angle) pair per scan line, in arrival order, and
 // says per line whether the sweep goes on, ends, or which lines are discarded and why. The
 // caller keeps the lines themselves (their points) in a queue in step with pendingLines():
 //

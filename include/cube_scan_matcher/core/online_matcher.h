@@ -83,7 +83,9 @@ struct OnlineStep {
   GateReason reason = GateReason::FirstScan;
   bool registered = false;         ///< align() ran (a reference existed and the scan had points).
   bool accepted = false;           ///< the registration result gave the increment.
-  bool odometry_guess = false;     ///< the guess came from odometry at both stamps (else identity).
+  /// The guess came from odometry at both stamps (else the last known pose moved on at the
+  /// last registered velocity, or not moved: OnlineMatcherSettings::constant_velocity).
+  bool odometry_guess = false;
   bool reference_updated = false;  ///< this scan is now the keyframe (the reference rebuilt).
   bool time_reset = false;         ///< time went backwards: state was reset before this scan.
   bool rejection_alarm = false;    ///< consecutive rejections >= max_consecutive_rejections.
@@ -91,10 +93,10 @@ struct OnlineStep {
   int reregistered = 0;            ///< de-skew rounds whose registration was kept (the result is the last's).
   int consecutive_rejections = 0;
   /// The gate's max_correction bounds were multiplied by this: the time since the reference
-  /// in whole scan periods (the lower quartile of the last 16 intervals), in [1, 4]; the
-  /// GNMM restart bounds are widened by the same factor for that registration. It is
-  /// > 1 when scans were dropped or skipped: the odometry error grows with every increment
-  /// the guess spans.
+  /// in whole scan periods (the lower quartile of the last 16 intervals), in [1, 4], and at
+  /// least no_odometry_scale without odometry; the GNMM restart bounds are widened by the
+  /// same factor for that registration. It is > 1 when scans were dropped or skipped: the
+  /// odometry error grows with every increment the guess spans.
   double gate_scale = 1.0;
   RegistrationResult result;       ///< valid when registered.
   Pose6 guess = Pose6::Zero();     ///< scan -> reference guess [m, rad].
@@ -169,6 +171,34 @@ class OnlineMatcher {
   bool addKeyframe(const PointArray& points, const Eigen::Isometry3d& pose, double stamp,
                    std::string& why);
   double gateScale(double stamp, double since) const;
+  /// The gate's settings with the correction bounds multiplied by `gate_scale`.
+  GateSettings scaledGate(double gate_scale) const;
+  /// The predicted pose T_map_base and the stamp [s] of the pose it was predicted from.
+  struct Prediction {
+    Eigen::Isometry3d pose;
+    double from;
+  };
+  // process()'s steps, in order.
+  static std::optional<Eigen::Isometry3d> usableOdometry(const std::optional<Eigen::Isometry3d>& odom,
+                                                        OnlineStep& step);
+  void trackTime(double stamp, OnlineStep& step);
+  Twist placedVelocity(double stamp, const std::optional<Eigen::Isometry3d>& odom,
+                       const PointTimes* times);
+  /// Also sets step.odometry_guess, step.increment and step.guess.
+  Prediction predict(double stamp, const std::optional<Eigen::Isometry3d>& odom,
+                     OnlineStep& step) const;
+  /// Registers around the guess (and from no motion, without odometry), with the search and
+  /// the gate widened by the scan periods the guess spans, and gates the result.
+  void registerAndGate(OnlineStep& step, const PointArray& points, double stamp,
+                       double predicted_from, const Keyframe& keyframe);
+  /// Sets step.pose; false when the chain guard refused the step (not a finite rigid motion).
+  bool placeScan(OnlineStep& step, const Keyframe* keyframe, const Eigen::Isometry3d& predicted);
+  void countRejections(OnlineStep& step, bool first);
+  /// The known pose, the velocity, the keyframes and the anchor after this scan.
+  void updateChain(OnlineStep& step, const PointArray& points, double stamp,
+                   const std::optional<Eigen::Isometry3d>& odom, const Keyframe* keyframe,
+                   bool first, bool refused);
+  static void describe(OnlineStep& step);
   /// De-skews an accepted scan with the registered motion over `interval` [s] since
   /// last_known_ into `out`, and registers it once more if the settings say so (keeping the
   /// second result only if the gate accepts it).

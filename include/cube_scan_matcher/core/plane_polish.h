@@ -69,7 +69,7 @@ struct PolishSettings {
   double collapse_fraction = 0.5;
   /// The polish is discarded (the cube result kept, the result unconfirmed, so searched again)
   /// when it moves the pose more than max_shift_m or max_shift_rad from the cube result, or
-  /// finds fewer than min_correspondences. 0.2 m (0.4 E; was 0.25 m until session 23): a
+  /// finds fewer than min_correspondences. 0.2 m (0.4 E): a
   /// polish that starts 0.2 m / 0.5 deg off after a poor refine walked 0.2497 m to a pose
   /// 11 cm off; right results move up to 0.24 m (robot worlds, p99 0.19 m), so this costs
   /// 13 of 5 900 accepted right results in the robot worlds and artefacts (BENCHMARK.md).
@@ -151,7 +151,7 @@ struct PolishResult {
 PolishResult polishOnPlanes(const PlaneMap& map, const PointArray& scan, const Pose6& pose,
                             const PolishSettings& settings);
 
-/// The continuous-time polish of a sweep taken while moving (issue 15).
+/// The continuous-time polish of a sweep taken while moving.
 struct SweepPolishResult {
   bool applied = false;
   std::string reason;        ///< why not applied

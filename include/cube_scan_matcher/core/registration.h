@@ -39,10 +39,9 @@ struct RegistrationSettings {
   RefineSettings refine;  ///< the fine stage (off in the paper's mode).
   PolishSettings polish;  ///< the point-to-plane polish and covariance (off in the paper's mode).
   /// Beyond the paper: before the search, keep one scan point per voxel of edge
-  /// collapse_fraction * E. 0 = off, every point is evaluated (paper). In [0, 1]. E/2 since
-  /// session 12 (was E/4): 1.1-1.35x faster on the real pairs, as accurate on the scene
-  /// benchmark once the axis probe and the consensus rule catch the wall's slides
-  /// (BENCHMARK.md, "Weak axes").
+  /// collapse_fraction * E. 0 = off, every point is evaluated (paper). In [0, 1]. E/2 is
+  /// 1.1-1.35x faster on the real pairs than E/4 and as accurate on the scene benchmark, with
+  /// the axis probe and the consensus rule catching the wall's slides (docs/experiments.md).
   double collapse_fraction = 0.5;
   /// Beyond the paper: the coarse search (and J_guess, J_coarse) uses only the scan points on
   /// densely sampled surfaces: those whose E-cube holds at least dense_points points of the
@@ -51,7 +50,7 @@ struct RegistrationSettings {
   /// 0 or 1 = off (every point, the paper); a scan with no such cube is used whole. In [0, 1000].
   /// Off by default for now: 4 cuts the drift of 150 m runs in the hall and park from 4-7 %
   /// to 0.2-0.6 %, but costs accuracy in some pairwise cases (BENCHMARK.md, "The no-motion
-  /// maximum"); issue 12 decides the default.
+  /// maximum"); the drift benchmarks decide its default.
   int dense_points = 0;
   /// Beyond the paper: the coarse search evaluates at most this many of the collapsed points,
   /// evenly spaced in scan order (J at the result and the gate's J use them all). 0 = all.
@@ -172,7 +171,7 @@ class CubeRegistration {
   /// working copies of them.
   std::size_t referenceBytes() const;
   std::size_t workspaceBytes() const;
-  /// polishSweepOnPlanes() on the reference's planes with the polish settings (issue 15).
+  /// polishSweepOnPlanes() on the reference's planes with the polish settings.
   /// Needs a reference with planes (else not applied, with the reason).
   SweepPolishResult polishSweep(const PointArray& scan, const std::vector<float>& tau,
                                 double interval, const Twist& placed,
@@ -200,8 +199,10 @@ class CubeRegistration {
   /// The E grid's objective bound to all the scan's points, collapsed as for the coarse stage:
   /// J at a result, before and after the polish and along the axis probe.
   CoincidenceObjective& resultObjective(const ScanPoints& points) const;
-  /// Coarse, refine and polish stages from the seeds of `attempt` (0 = the first).
+  /// Probes J along the weakest translation axis of a polished result and moves it to a
+  /// clearly higher J there (SearchSettings::axis_probe_m, axis_probe_gain).
   void axisProbeStage(const ScanPoints& points, RegistrationResult& res) const;
+  /// Coarse, refine and polish stages from the seeds of `attempt` (0 = the first).
   void searchAttempt(const ScanPoints& points, const Pose6& guess, int attempt,
                      RegistrationResult& res, std::vector<Pose6>& ranked,
                      std::vector<int>& ranked_J) const;

@@ -1,6 +1,6 @@
 // SweepAssemblerNodelet: assembles the lines (sensor_msgs/LaserScan) of a tilting 2D laser into
-// one sensor_msgs/PointCloud2 per sweep in a fixed frame (issue 15, part 2; laser_assembler is
-// not in Debian). Each line is projected with laser_geometry into fixed_frame, each beam placed
+// one sensor_msgs/PointCloud2 per sweep in a fixed frame (laser_assembler is not in
+// Debian). Each line is projected with laser_geometry into fixed_frame, each beam placed
 // by the tf at its own time (laser_geometry interpolates between the transforms at the line's
 // first and last beam); lines whose tf has not arrived yet wait up to tf_timeout. Where a sweep
 // ends is decided by assembly/sweep_cutter.h from the tilt angle (the scan frame's rotation

@@ -44,7 +44,7 @@ class RobotMotion {
 /// `height` [m] above the ground, pitch and roll from the ground's slope over a 1 m footprint.
 Eigen::Isometry3d placeOnGround(const Scene& scene, double x, double y, double heading, double height);
 
-/// Continuous motion for sweeps taken while driving (issue 15): constant speed along the
+/// Continuous motion for sweeps taken while driving: constant speed along the
 /// heading, and a yaw rate whose sign flips every `interval` (a zigzag about the heading
 /// `heading0` the path starts from: the heading sweeps between heading0 -+ yaw_rate *
 /// interval / 2, so the robot stays within speed / yaw_rate * (1 - cos(yaw_rate * interval

@@ -26,7 +26,7 @@ struct Sphere {
   double r;
 };
 
-/// The paper's four scene types (section 3.2), then six that robots meet beyond them (issue 12):
+/// The paper's four scene types (section 3.2), then six that robots meet beyond them:
 ///  - square: an open paved square, a few small objects, facades 55-75 m away (little structure);
 ///  - slope: steep (7 deg) rough terrain, bumps and rocks, few upright surfaces;
 ///  - forest: dense vegetation, hundreds of thin trunks and bushes of small spheres;

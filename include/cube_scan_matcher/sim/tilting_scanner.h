@@ -61,7 +61,7 @@ PointArray scan(const Scene& scene, const ScannerModel& model, const Eigen::Isom
 PointArray scanLine(const Scene& scene, const ScannerModel& model, const Eigen::Isometry3d& sensor_pose,
                     double psi, std::mt19937_64& rng, bool keep_invalid = true);
 
-/// A sweep taken while the scanner moves (issue 15): the model's 2D lines evenly spaced in time
+/// A sweep taken while the scanner moves: the model's 2D lines evenly spaced in time
 /// over [t_ref - duration, t_ref] (the reference time is the last line's), each cast from
 /// `sensor_pose(t)` (T_world_sensor, eq. 1's frame) at its own time; tilt_up: the first line
 /// at psi_min, else at psi_max (a tilting scanner sweeps up and down in turn). Beams within a
