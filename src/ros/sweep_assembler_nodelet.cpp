@@ -12,7 +12,7 @@
 #include <sensor_msgs/point_cloud2_iterator.h>
 #include <tf2/exceptions.h>
 
-#include "cube_scan_matcher/ros/params.h"
+#include "cube_scan_matcher/ros/read_param.h"
 
 namespace cube_scan_matcher {
 

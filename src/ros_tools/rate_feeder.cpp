@@ -20,7 +20,7 @@
 #include "cube_scan_matcher/Status.h"
 #include "cube_scan_matcher/core/metrics.h"
 #include "cube_scan_matcher/ros/cloud_conversion.h"
-#include "cube_scan_matcher/ros/params.h"
+#include "cube_scan_matcher/ros/read_param.h"
 #include "cube_scan_matcher/ros/transforms.h"
 #include "cube_scan_matcher/sim/motion.h"
 #include "cube_scan_matcher/sim/tilting_scanner.h"

@@ -29,7 +29,7 @@
 #include "cube_scan_matcher/core/deskew.h"
 #include "cube_scan_matcher/core/pose.h"
 #include "cube_scan_matcher/ros/cloud_conversion.h"
-#include "cube_scan_matcher/ros/params.h"
+#include "cube_scan_matcher/ros/read_param.h"
 #include "cube_scan_matcher/ros/transforms.h"
 #include "cube_scan_matcher/sim/motion.h"
 #include "cube_scan_matcher/sim/tilting_scanner.h"

@@ -29,7 +29,7 @@
 #include <tf2_ros/static_transform_broadcaster.h>
 #include <tf2_ros/transform_broadcaster.h>
 
-#include "cube_scan_matcher/ros/params.h"
+#include "cube_scan_matcher/ros/read_param.h"
 #include "cube_scan_matcher/ros/sweep_assembler_nodelet.h"
 #include "cube_scan_matcher/ros/transforms.h"
 #include "ros_test_helpers.h"
