@@ -1,5 +1,6 @@
 // The defaults of cfg/ScanMatcher.cfg (dynamic_reconfigure) must equal the C++ defaults
-// (RegistrationSettings{} via NodeParams), so the cfg, the YAML, the README and the code agree.
+// (RegistrationSettings{} via NodeParams), so the cfg, the YAML, docs/parameters.md and the code
+// agree.
 #include <gtest/gtest.h>
 
 #include <fstream>
@@ -100,10 +101,10 @@ void expectDocumented(const ScanMatcherConfig::AbstractParamDescriptionConstPtr&
 }  // namespace
 
 // cfg/ScanMatcher.cfg is the one source of the live parameters: config/scan_matcher.yaml and
-// the README's parameter table list exactly its parameters, with its defaults and ranges.
+// docs/parameters.md's parameter table list exactly its parameters, with its defaults and ranges.
 TEST(Params, YamlAndReadmeListTheCfgParametersWithItsDefaultsAndRanges) {
   const auto yaml = lines(readFile(CSM_SOURCE_DIR "/config/scan_matcher.yaml"));
-  const auto readme = lines(readFile(CSM_SOURCE_DIR "/README.md"));
+  const auto readme = lines(readFile(CSM_SOURCE_DIR "/docs/parameters.md"));
   std::set<std::string> names;
   for (const auto& d : ScanMatcherConfig::__getParamDescriptions__()) {
     names.insert(d->name);
@@ -121,7 +122,7 @@ TEST(Params, YamlAndReadmeListTheCfgParametersWithItsDefaultsAndRanges) {
                        trim(l.substr(colon + 1, hash - colon - 1)), range);
     }
     EXPECT_EQ(found, 1) << "config/scan_matcher.yaml lines for " << d->name;
-    // README: "| name (live) | unit | default | range | meaning |".
+    // docs/parameters.md: "| name (live) | unit | default | range | meaning |".
     found = 0;
     for (const std::string& l : readme) {
       if (l.rfind("| " + d->name + " (live) |", 0) != 0) continue;
@@ -130,15 +131,16 @@ TEST(Params, YamlAndReadmeListTheCfgParametersWithItsDefaultsAndRanges) {
       std::stringstream ss(l);
       for (std::string cell; std::getline(ss, cell, '|');) cells.push_back(trim(cell));
       ASSERT_GE(cells.size(), 6u) << l;
-      expectDocumented(d, "README.md", cells[3], cells[4]);
+      expectDocumented(d, "docs/parameters.md", cells[3], cells[4]);
     }
-    EXPECT_EQ(found, 1) << "README.md rows for " << d->name;
+    EXPECT_EQ(found, 1) << "docs/parameters.md rows for " << d->name;
   }
   // Nothing documented as live that the cfg does not have.
   for (const std::string& l : readme) {
     const std::size_t live = l.find(" (live) |");
     if (l.rfind("| ", 0) == 0 && live != std::string::npos) {
-      EXPECT_EQ(names.count(l.substr(2, live - 2)), 1u) << "README row not in the cfg: " << l;
+      EXPECT_EQ(names.count(l.substr(2, live - 2)), 1u)
+          << "docs/parameters.md row not in the cfg: " << l;
     }
   }
 }
