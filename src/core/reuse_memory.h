@@ -2,7 +2,7 @@
 // working copies, the keyframe submap) keep their memory. A buffer that must grow is allocated
 // with a quarter of headroom, so that the next, slightly larger rebuild reuses it: fresh pages
 // cost a fault each when first written (about 10 us on a VM), which made up most of a
-// keyframe's rebuild in the rate benchmark (BENCHMARK.md, "Page faults at keyframes").
+// keyframe's rebuild in the rate benchmark (docs/experiments.md, the speed record).
 #pragma once
 
 #include <cstddef>

@@ -1,7 +1,7 @@
 // simulator_node: the paper's tilting 2D scanner (section 3.1) on a robot in a procedural scene,
 // with a simulated DGPS/IMU odometry (configurable errors) and the exact truth on ground_truth
 // (PoseStamped, frame map = the world, which equals odom at the first sweep). Two outputs
-// (~input, README "Simulator"):
+// (~input, docs/method.md "The simulator"):
 //  - sweeps: a sweep taken from one pose at a time (stop and go) and assembled in the simulator:
 //    per sweep tf odom -> base_link, the cloud in the scanner frame at the same stamp and the
 //    truth; the static base_link -> scanner mount is published once.

@@ -379,7 +379,7 @@ TEST_F(SweepAssemblerRos, TimeGoingBackwardsResetsOnceAndAssemblyGoesOn) {
 
 // config/sweep_assembler.yaml: loads (with a tilt frame: the YAML alone has neither a tilt
 // frame nor a duration, and is refused naming sweep_duration), equals the code's defaults,
-// and every parameter in it is read and validated by the nodelet and has a README row with
+// and every parameter in it is read and validated by the nodelet and has a docs/parameters.md row with
 // the same default.
 TEST(SweepAssemblerYaml, HoldsTheDefaultsAndEveryParameterIsReadAndDocumented) {
   const std::string ns = "/yaml_check";
@@ -436,12 +436,14 @@ TEST(SweepAssemblerYaml, HoldsTheDefaultsAndEveryParameterIsReadAndDocumented) {
       EXPECT_NE(std::string(e.what()).find("~" + name), std::string::npos) << e.what();
     }
   }
-  // README: "| name | unit | default | range | meaning |" rows in the "Sweep assembler" section.
-  std::ifstream readme(CSM_SOURCE_DIR "/README.md");
+  // docs/parameters.md: "| name | unit | default | range | meaning |" rows in the
+  // "SweepAssemblerNodelet" section.
+  std::ifstream doc_file(CSM_SOURCE_DIR "/docs/parameters.md");
+  ASSERT_TRUE(doc_file.good()) << "docs/parameters.md not found";
   bool in_section = false;
   std::map<std::string, std::string> documented;
-  for (std::string l; std::getline(readme, l);) {
-    if (l.rfind("## ", 0) == 0) in_section = l == "## Sweep assembler";
+  for (std::string l; std::getline(doc_file, l);) {
+    if (l.rfind("## ", 0) == 0) in_section = l == "## SweepAssemblerNodelet";
     if (!in_section || l.rfind("| ", 0) != 0) continue;
     std::vector<std::string> cells;
     std::stringstream ss(l);
@@ -453,14 +455,14 @@ TEST(SweepAssemblerYaml, HoldsTheDefaultsAndEveryParameterIsReadAndDocumented) {
     if (cells.size() >= 6 && defaults.count(cells[1])) documented[cells[1]] = cells[3];
   }
   for (const auto& [name, value] : defaults) {
-    ASSERT_EQ(documented.count(name), 1u) << "README has no row for " << name;
+    ASSERT_EQ(documented.count(name), 1u) << "docs/parameters.md has no row for " << name;
     const std::string& doc = documented[name];
     char* end = nullptr;
     const double number = std::strtod(value.c_str(), &end);
     if (end != value.c_str() && *end == '\0') {
-      EXPECT_DOUBLE_EQ(std::stod(doc), number) << "README default of " << name;
+      EXPECT_DOUBLE_EQ(std::stod(doc), number) << "docs/parameters.md default of " << name;
     } else {
-      EXPECT_EQ(doc, value == "\"\"" ? "\"\"" : value) << "README default of " << name;
+      EXPECT_EQ(doc, value == "\"\"" ? "\"\"" : value) << "docs/parameters.md default of " << name;
     }
   }
 }

@@ -45,7 +45,7 @@ struct PolishSettings {
   /// Sharpness p of the trilinear weights: along each axis a point at fraction f between two
   /// voxel centres weighs the lower one (1-f)^p / ((1-f)^p + f^p), the upper one f^p / (same).
   /// 1 = plain trilinear; a larger p leans on the nearest voxel's plane (still continuous).
-  /// Scene benchmark (BENCHMARK.md, "Sharpened trilinear weights"): p = 2 lowers the median Es
+  /// Scene benchmark (docs/experiments.md, "Sharpened trilinear weights"): p = 2 lowers the median Es
   /// of natural, park and slope by 1-1.6 mm at the same repeatability, but the open square's
   /// 10-12 cm slides are accepted more often (false accepts 1 -> 3 of 2400 in the robot worlds,
   /// 2 -> 3 of 2000 with the sensor's artefacts), so 1 stays the default. In [1, 8].
@@ -61,7 +61,7 @@ struct PolishSettings {
   /// collects them again where the pose is now (on one set for long, the steps can drift to
   /// where that set fits best as points leave their planes: an open square's 0.49 deg yaw
   /// drift, accepted 10.5 cm off). 8 removes that false accept; with max_shift_m 0.2 m it
-  /// does not add another (BENCHMARK.md, "The polish's rounds" and "A polish that must stay
+  /// does not add another (docs/experiments.md, "The polish's rounds" and "A polish that must stay
   /// near the cube result"). 0 = a round ends only when it converges. In [0, 100].
   int round_steps = 8;
   /// The polish evaluates the scan collapsed to one point per voxel of this * E (the refine
@@ -102,7 +102,7 @@ struct PolishSettings {
   /// not once per point. The plain term alone left 46 % of the forest's accepted results
   /// beyond 3 sd along x (a 1 cm bias towards the motion) and 14-16 % of the square's; 2 m
   /// cubes and 25 bring every scene type of the robot worlds except the square to <= 1 %
-  /// (BENCHMARK.md, "A covariance from the residuals' clusters"). covariance_cell_m 0 = off;
+  /// (docs/experiments.md, "A covariance from the residuals' clusters"). covariance_cell_m 0 = off;
   /// in [0, 100] m; scale in [0, 1e6].
   double covariance_cell_m = 2.0;
   double covariance_cell_scale = 25.0;
@@ -111,7 +111,7 @@ struct PolishSettings {
   /// direction (an open square's few small objects), the fit absorbs part of each one's error
   /// and its residual shows only (1 - leverage) of it; the jackknife restores it. H - H_c is
   /// replaced by H - (1 - 1/cap) H_c >= H / cap: a cube widens its share at most cap times in
-  /// sd. 3 brings the square's yaw tail beyond 3 sd from 2.5 % to 1.3 % (BENCHMARK.md, "A
+  /// sd. 3 brings the square's yaw tail beyond 3 sd from 2.5 % to 1.3 % (docs/experiments.md, "A
   /// jackknife over the cubes"); <= 1 = off. In [0, 1e6].
   double covariance_jackknife_cap = 3.0;
   /// A correspondence carries information along a translation axis only when its plane's

@@ -49,8 +49,8 @@ struct RegistrationSettings {
   /// laid where the reference was taken); the refine stage and the result's J use all points.
   /// 0 or 1 = off (every point, the paper); a scan with no such cube is used whole. In [0, 1000].
   /// Off by default for now: 4 cuts the drift of 150 m runs in the hall and park from 4-7 %
-  /// to 0.2-0.6 %, but costs accuracy in some pairwise cases (BENCHMARK.md, "The no-motion
-  /// maximum"); the drift benchmarks decide its default.
+  /// to 0.2-0.6 %, but costs accuracy in some pairwise cases (docs/experiments.md, "The
+  /// no-motion maximum and dense_points"); the drift benchmarks decide its default.
   int dense_points = 0;
   /// Beyond the paper: the coarse search evaluates at most this many of the collapsed points,
   /// evenly spaced in scan order (J at the result and the gate's J use them all). 0 = all.

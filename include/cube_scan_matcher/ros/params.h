@@ -1,6 +1,6 @@
 // Every parameter of ScanMatcherNodelet, read and validated in one place. Out-of-range values
 // raise ParamError naming the parameter; the nodelet refuses to start with it. The same names,
-// units and defaults are in config/scan_matcher.yaml, cfg/ScanMatcher.cfg and the README.
+// units and defaults are in config/scan_matcher.yaml, cfg/ScanMatcher.cfg and docs/parameters.md.
 #pragma once
 
 #include <string>

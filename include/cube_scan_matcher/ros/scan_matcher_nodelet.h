@@ -1,6 +1,6 @@
 // ScanMatcherNodelet: the ROS face of the package. A thin layer over core/online_matcher.h:
 // it reads clouds and tf, calls the core, and publishes pose, odometry, path, registered cloud,
-// status, optional tf and diagnostics. Topics, frames and parameters: README.md.
+// status, optional tf and diagnostics. Topics and frames: README.md; parameters: docs/parameters.md.
 #pragma once
 
 #include <deque>

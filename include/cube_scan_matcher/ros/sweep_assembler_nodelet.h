@@ -5,7 +5,7 @@
 // first and last beam); lines whose tf has not arrived yet wait up to tf_timeout. Where a sweep
 // ends is decided by assembly/sweep_cutter.h from the tilt angle (the scan frame's rotation
 // relative to tilt_reference_frame about tilt_axis) or by duration. Topics, parameters and the
-// cloud's layout: README.md, "Sweep assembler".
+// cloud's layout: README.md, "Sweep assembler", and docs/method.md.
 #pragma once
 
 #include <cstdint>
@@ -31,7 +31,7 @@
 
 namespace cube_scan_matcher {
 
-/// Every parameter of SweepAssemblerNodelet (config/sweep_assembler.yaml, README table).
+/// Every parameter of SweepAssemblerNodelet (config/sweep_assembler.yaml, docs/parameters.md).
 struct AssemblerParams {
   std::string fixed_frame = "odom";  ///< frame of the assembled clouds; fixed in the world.
   /// The mount frame the tilt is measured against; empty = no tilt (duration mode only).
