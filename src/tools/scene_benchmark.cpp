@@ -54,6 +54,8 @@ void usage(std::ostream& os) {
         "                        >= P %% of its trials (default off)\n"
         "  --check-false-accepts N  exit 2 if more than N trials in all are accepted by the\n"
         "                        gate but wrong (default off)\n"
+        "  --check-accepted N    exit 2 if fewer than N trials in all are accepted by the gate\n"
+        "                        and right (default off): a gate that rejects everything fails\n"
         "  --repeat K            also register each pair from K starts in each bounds and\n"
         "                        report the repeatability: the median over pairs of each\n"
         "                        pair's median distance to its own median pose (default 1 = off)\n"
@@ -128,7 +130,7 @@ int main(int argc, char** argv) {
   int worlds = 20, trials = 10, first_world = 1;
   std::uint64_t seed = 1;
   std::string csv_path = "scenes.csv";
-  double check_success = -1, check_false_accepts = -1;
+  double check_success = -1, check_false_accepts = -1, check_accepted = -1;
   int repeat = 1;
   double check_rep_m = -1, check_rep_deg = -1;
   bool artefacts = false;
@@ -162,6 +164,7 @@ int main(int argc, char** argv) {
       else if (a == "--csv") csv_path = v;
       else if (a == "--check-success") check_success = io::parseNumber(a, v);
       else if (a == "--check-false-accepts") check_false_accepts = io::parseNumber(a, v);
+      else if (a == "--check-accepted") check_accepted = io::parseNumber(a, v);
       else if (a == "--repeat") repeat = int(io::parseNumber(a, v));
       else if (a == "--check-repeatability") {
         if (i + 2 >= args.size()) throw std::invalid_argument(a + ": expects M D");
@@ -283,7 +286,7 @@ int main(int argc, char** argv) {
     std::map<std::tuple<std::string, std::string, std::string>, std::vector<const Row*>> groups;
     for (const Row& r : rows) groups[{r.scene, r.motion, r.bounds}].push_back(&r);
     std::vector<std::string> failures;
-    int false_accepts = 0;
+    int false_accepts = 0, accepted_right = 0;
     for (const auto& [key, group] : groups) {
       std::vector<double> es, ea, time;
       std::vector<double> sd_t, sd_r;
@@ -302,6 +305,7 @@ int main(int argc, char** argv) {
         fr += !r->accepted() && r->success();
       }
       false_accepts += fa;
+      accepted_right += acc - fa;
       const double pct = 100.0 * ok / double(group.size());
       // Repeatability: the median over the group's pairs.
       std::vector<double> rep_m, rep_deg;
@@ -340,6 +344,10 @@ int main(int argc, char** argv) {
     if (check_false_accepts >= 0 && false_accepts > check_false_accepts) {
       failures.push_back(std::to_string(false_accepts) + " false accepts > " +
                          std::to_string(int(check_false_accepts)));
+    }
+    if (check_accepted >= 0 && accepted_right < check_accepted) {
+      failures.push_back(std::to_string(accepted_right) + " accepted right results < " +
+                         std::to_string(int(check_accepted)));
     }
     for (const std::string& f : failures) std::fprintf(stderr, "CHECK FAILED %s\n", f.c_str());
     if (!failures.empty()) return 2;
