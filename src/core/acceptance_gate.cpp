@@ -30,8 +30,6 @@ std::string toString(GateReason reason) {
 void validate(const GateSettings& s) {
   if (!(s.min_overlap >= 0.0 && s.min_overlap <= 1.0))
     throw std::invalid_argument("min_overlap must be in [0, 1], got " + std::to_string(s.min_overlap));
-  if (s.min_j_gain < 0)
-    throw std::invalid_argument("min_j_gain must be >= 0, got " + std::to_string(s.min_j_gain));
   if (!(s.max_correction_m > 0.0 && std::isfinite(s.max_correction_m)))
     throw std::invalid_argument("max_correction_translation must be > 0 m");
   if (!(s.max_correction_rad > 0.0 && std::isfinite(s.max_correction_rad)))
@@ -50,7 +48,7 @@ GateReason gate(const RegistrationResult& r, const Pose6& guess, const GateSetti
   // The gain of the search on the objective it maximised against the guess: the coarse stage's
   // best J (eq. 5 on the E grid). J at the refined pose can be a few cubes below J at an exact
   // guess (the refine optimises the finer grids), which is no sign of a bad result.
-  if (r.J_coarse < r.J_guess + s.min_j_gain) return GateReason::NoGain;
+  if (r.J_coarse < r.J_guess) return GateReason::NoGain;
   const Eigen::Isometry3d c = poseToIsometry(guess).inverse() * r.transform;
   if (c.translation().norm() > s.max_correction_m ||
       Eigen::AngleAxisd(c.linear()).angle() > s.max_correction_rad) {

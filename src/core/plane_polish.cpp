@@ -25,7 +25,6 @@ void validate(const PolishSettings& s) {
   requireInRange("polish.tolerance_rad", s.tolerance_rad, 0.0, 0.01);
   requireInRange("polish.max_overrelaxation", s.max_overrelaxation, 1.0, 4.0);
   requireInRange("polish.round_steps", s.round_steps, 0, 100);
-  requireInRange("polish.trilinear_sharpness", s.trilinear_sharpness, 1.0, 8.0);
   requireInRange("polish.collapse_fraction", s.collapse_fraction, 0.0, 2.0);
   requireInRange("polish.max_shift_m", s.max_shift_m, 1e-4, 10.0);
   requireInRange("polish.max_shift_rad", s.max_shift_rad, 1e-5, 1.0);
@@ -128,8 +127,7 @@ struct Corners {
 };
 
 /// Trilinear correspondences: each scan point is paired with the planes of the 8 voxels whose
-/// centres surround q, each weighted by q's trilinear weight for that centre (they sum to 1),
-/// sharpened per axis by `sharpness` p: (1-f)^p / ((1-f)^p + f^p) for the lower centre.
+/// centres surround q, each weighted by q's trilinear weight for that centre (they sum to 1).
 /// The weights vary continuously with the pose, so the objective has no steps where a point
 /// crosses a voxel face: a polish started a centimetre apart ends on the same pose.
 /// `corners[i]` caches point i's planes; they are looked up again only when q moves into
@@ -137,7 +135,7 @@ struct Corners {
 /// (and their corners, in `near_corners`).
 Linearisation lineariseTrilinear(const PlaneMap& map, const PointArray& scan,
                                  const Eigen::Matrix3d& R, const Eigen::Vector3d& t,
-                                 double kernel, double sharpness, std::vector<Corners>& corners,
+                                 double kernel, std::vector<Corners>& corners,
                                  PointArray* near = nullptr,
                                  std::vector<Corners>* near_corners = nullptr) {
   Linearisation L;
@@ -155,13 +153,7 @@ Linearisation lineariseTrilinear(const PlaneMap& map, const PointArray& scan,
       const double u = q[k] * inv - 0.5;
       const double lower = std::floor(u);
       const double f = u - lower;
-      if (sharpness == 1.0) {
-        g[k][0] = 1.0 - f, g[k][1] = f;
-      } else {
-        const double lo = sharpness == 2.0 ? (1.0 - f) * (1.0 - f) : std::pow(1.0 - f, sharpness);
-        const double hi = sharpness == 2.0 ? f * f : std::pow(f, sharpness);
-        g[k][0] = lo / (lo + hi), g[k][1] = hi / (lo + hi);
-      }
+      g[k][0] = 1.0 - f, g[k][1] = f;
       b[k] = std::int64_t(std::clamp(lower, -double(1 << 20), double(1 << 20))) + (1 << 20);
     }
     Corners& c = corners[i];
@@ -327,11 +319,11 @@ PolishResult polishOnPlanes(const PlaneMap& map, const PointArray& scan, const P
   // A collecting pass runs over every scan point and fills `near`; the others over `near`.
   auto lineariseAt = [&](bool collect) {
     if (!s.trilinear) return linearise(map, collect ? scan : near, R, t, s.kernel, collect ? &near : nullptr);
-    if (!collect) return lineariseTrilinear(map, near, R, t, s.kernel, s.trilinear_sharpness, near_corners);
+    if (!collect) return lineariseTrilinear(map, near, R, t, s.kernel, near_corners);
     // The first round's corners stay valid as a cache for the second round's collecting pass
     // (the pose has moved by centimetres at most).
     if (it == 0) all_corners.assign(scan.size(), Corners());
-    return lineariseTrilinear(map, scan, R, t, s.kernel, s.trilinear_sharpness, all_corners,
+    return lineariseTrilinear(map, scan, R, t, s.kernel, all_corners,
                               &near, &near_corners);
   };
   double stretch = 1.0;  // over-relaxation of the last step

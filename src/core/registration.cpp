@@ -284,8 +284,7 @@ void CubeRegistration::coarseStage(const ScanPoints& points, const Pose6& guess,
 void CubeRegistration::refineStage(const ScanPoints& points, const std::vector<Pose6>& ranked,
                                    RegistrationResult& res) const {
   const RefineSettings& rs = settings_.refine;
-  const Eigen::Vector3d pivot =
-      rs.centroid_pivot ? centroid(*points.fine) : Eigen::Vector3d::Zero();
+  const Eigen::Vector3d pivot = centroid(*points.fine);
   std::vector<MultiScaleObjective> objectives;
   for (auto& w : workspaces_) {
     std::vector<CoincidenceObjective*> fine;

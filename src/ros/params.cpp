@@ -58,7 +58,6 @@ void configToSettings(const ScanMatcherConfig& c, OnlineMatcherSettings& m) {
   r.polish.covariance_cell_scale = c.covariance_cell_scale;
   r.polish.covariance_jackknife_cap = c.covariance_jackknife;
   m.gate.min_overlap = c.min_overlap;
-  m.gate.min_j_gain = c.min_j_gain;
   m.gate.max_correction_m = c.max_correction_translation;
   m.gate.max_correction_rad = deg2rad(c.max_correction_rotation);
   m.gate.require_polish = c.require_polish;
@@ -149,7 +148,6 @@ ScanMatcherConfig toConfig(const NodeParams& p) {
   c.covariance_cell_scale = r.polish.covariance_cell_scale;
   c.covariance_jackknife = r.polish.covariance_jackknife_cap;
   c.min_overlap = p.matcher.gate.min_overlap;
-  c.min_j_gain = p.matcher.gate.min_j_gain;
   c.max_correction_translation = p.matcher.gate.max_correction_m;
   c.max_correction_rotation = rad2deg(p.matcher.gate.max_correction_rad);
   c.require_polish = p.matcher.gate.require_polish;

@@ -69,8 +69,6 @@ std::string algorithmOptionsHelp() {
          "  --polish-iterations N Gauss-Newton steps of the polish (default " + std::to_string(d.polish.max_iterations) + ")\n"
          "  --polish-trilinear B  1: each point meets the planes of the 8 voxels around it,\n"
          "                        trilinearly weighted; 0: its own voxel's plane (default " + std::to_string(int(d.polish.trilinear)) + ")\n"
-         "  --polish-sharpness P  trilinear weights sharpened to (1-f)^P, f^P per axis,\n"
-         "                        normalised; 1 = plain trilinear (default " + num(d.polish.trilinear_sharpness) + ")\n"
          "  --polish-overrelax F  a polish step along the last one's direction is stretched\n"
          "                        up to F times, 1 = plain Gauss-Newton (default " + num(d.polish.max_overrelaxation) + ")\n"
          "  --polish-round-steps N  steps per round of the polish before its points are\n"
@@ -89,8 +87,6 @@ std::string algorithmOptionsHelp() {
          "                        (default " + num(d.refine.collapse_fraction) + ")\n"
          "  --refine-grids K      refine on the sum of J over K fine grids shifted by 1/K cube\n"
          "                        (anti-aliasing; default " + std::to_string(d.refine.grids) + ")\n"
-         "  --refine-pivot P      compass rotations turn about the scan 'centroid' or its 'origin'\n"
-         "                        (default " + std::string(d.refine.centroid_pivot ? "centroid" : "origin") + ")\n"
          "  --refine-levels N     compass-search step sizes in the refine stage, each half the one\n"
          "                        before (default " + std::to_string(d.refine.compass.levels) + ")\n"
          "  --refine-step T A     first compass steps T [m], A [deg] (default " + num(d.refine.compass.initial_step[0]) + " m, " + num(rad2deg(d.refine.compass.initial_step[3])) + " deg)\n"
@@ -165,8 +161,6 @@ bool parseAlgorithmOption(const std::vector<std::string>& args, std::size_t& i,
     s.polish.max_iterations = int(value(1)), used = 2;
   } else if (a == "--polish-trilinear") {
     s.polish.trilinear = value(1) != 0.0, used = 2;
-  } else if (a == "--polish-sharpness") {
-    s.polish.trilinear_sharpness = value(1), used = 2;
   } else if (a == "--polish-overrelax") {
     s.polish.max_overrelaxation = value(1), used = 2;
   } else if (a == "--polish-max-shift") {
@@ -218,12 +212,6 @@ bool parseAlgorithmOption(const std::vector<std::string>& args, std::size_t& i,
     s.gnmm.seed = std::uint64_t(value(1)), used = 2;
   } else if (a == "--max-byte-cubes") {
     s.grid.max_byte_cubes = std::uint64_t(value(1)), used = 2;
-  } else if (a == "--refine-pivot") {
-    const std::string& v = word(1);
-    if (v != "centroid" && v != "origin") {
-      throw std::invalid_argument(a + ": expected centroid or origin, got '" + v + "'");
-    }
-    s.refine.centroid_pivot = v == "centroid", used = 2;
   } else if (a == "--max-cubes") {
     s.grid.max_cubes = std::uint64_t(value(1)), used = 2;
   } else if (a == "--min-range") {

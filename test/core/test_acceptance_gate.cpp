@@ -21,9 +21,9 @@ TEST(AcceptanceGate, RejectsLowOverlapNoGainAndLargeCorrections) {
   g.min_overlap = 0.6;
   EXPECT_EQ(gate(r, guess, g), GateReason::LowOverlap);
   g = GateSettings{};
-  g.min_j_gain = 200;
+  r.J_guess = 501;  // the search ended below its own start
   EXPECT_EQ(gate(r, guess, g), GateReason::NoGain);
-  g = GateSettings{};
+  r.J_guess = 400;
   g.max_correction_m = 0.1;
   EXPECT_EQ(gate(r, guess, g), GateReason::CorrectionTooLarge);
   r.status = RegistrationStatus::NoOverlap;

@@ -15,7 +15,7 @@ enum class GateReason : std::uint8_t {
   Accepted = 0,            ///< registration used.
   FirstScan = 1,           ///< no previous scan: the scan becomes the reference.
   LowOverlap = 2,          ///< J / l below min_overlap.
-  NoGain = 3,              ///< coarse-stage J below J at the guess + min_j_gain.
+  NoGain = 3,              ///< coarse-stage J below J at the guess.
   CorrectionTooLarge = 4,  ///< result too far from the guess.
   RegistrationFailed = 5,  ///< the core returned no result (no overlap, empty scan).
   BadReference = 6,        ///< this scan's cube grid could not be built (e.g. memory cap).
@@ -33,7 +33,6 @@ std::string toString(GateReason reason);
 
 struct GateSettings {
   double min_overlap = 0.10;           ///< minimum J / l, in [0, 1].
-  int min_j_gain = 0;  ///< the coarse stage's J must be >= J at the guess + this, >= 0.
   double max_correction_m = 2.0;       ///< |translation of guess^-1 * result| [m], > 0.
   double max_correction_rad = 0.2617993877991494;  ///< rotation angle of the same [rad], > 0.
   /// Reject a result the polish ran on but did not apply: it moved more than its max_shift from

@@ -13,7 +13,7 @@ struct CompassSettings {
                            0.017453292519943295, 0.017453292519943295).finished();
   /// Step sizes tried, in [1, 30]: the first step, then levels - 1 halvings (last step =
   /// initial / 2^(levels-1)).
-  int levels = 5;
+  int levels = 4;
   int max_evaluations = 2000;     ///< hard budget, in [1, 1e7].
 };
 

@@ -42,14 +42,6 @@ struct PolishSettings {
   /// mm / 0.03-0.08 deg apart with one plane per point, 0.1-0.2 mm / 0.001-0.003 deg with 8).
   /// false: the plane of the point's own voxel only.
   bool trilinear = true;
-  /// Sharpness p of the trilinear weights: along each axis a point at fraction f between two
-  /// voxel centres weighs the lower one (1-f)^p / ((1-f)^p + f^p), the upper one f^p / (same).
-  /// 1 = plain trilinear; a larger p leans on the nearest voxel's plane (still continuous).
-  /// Scene benchmark (docs/experiments.md, "Sharpened trilinear weights"): p = 2 lowers the median Es
-  /// of natural, park and slope by 1-1.6 mm at the same repeatability, but the open square's
-  /// 10-12 cm slides are accepted more often (false accepts 1 -> 3 of 2400 in the robot worlds,
-  /// 2 -> 3 of 2000 with the sensor's artefacts), so 1 stays the default. In [1, 8].
-  double trilinear_sharpness = 1.0;
   /// Over-relaxation: a step that keeps the previous step's direction (cosine > 0.8 in units
   /// where 1 rad = 1 m at the scan's radius of gyration) is taken 1.5 times as long as the
   /// previous one was stretched, up to this factor; any other step as computed. The robust

@@ -31,15 +31,10 @@ struct RefineSettings {
   /// The refine stage evaluates the scan collapsed to one point per voxel of this * E (the
   /// coarse stage uses RegistrationSettings::collapse_fraction). 0 = all points. In [0, 1].
   double collapse_fraction = 0.25;
-  /// Compass rotations pivot about the centroid of the scan points (true) or the scan origin.
-  bool centroid_pivot = true;
-  /// Compass search: first steps 0.125 m / 1 deg, `levels` = 4 step sizes (halved 3 times,
-  /// last 15.6 mm / 0.125 deg; the polish takes it from there: 5 levels before it).
-  CompassSettings compass = [] {
-    CompassSettings c;
-    c.levels = 4;
-    return c;
-  }();
+  /// Compass search (its rotations pivot about the centroid of the scan points): first steps
+  /// 0.125 m / 1 deg, 4 step sizes (halved 3 times, last 15.6 mm / 0.125 deg; the polish
+  /// takes it from there).
+  CompassSettings compass;
 };
 
 /// Throws std::invalid_argument naming the bad setting (only when enabled).
