@@ -214,8 +214,8 @@ OnlineStep OnlineMatcher::process(const PointArray& scan_points, double stamp,
     }
   }
   const bool refused = !placeScan(step, keyframe, predicted.pose);
-  countRejections(step, first);
-  updateChain(step, deskewed ? *deskewed : scan_points, stamp, odom, keyframe, first, refused);
+  countRejections(step, keyframe);
+  updateChain(step, deskewed ? *deskewed : scan_points, stamp, odom, keyframe, refused);
   describe(step);
   return step;
 }
@@ -335,8 +335,8 @@ bool OnlineMatcher::placeScan(OnlineStep& step, const Keyframe* keyframe,
   return false;
 }
 
-void OnlineMatcher::countRejections(OnlineStep& step, bool first) {
-  const bool rejected = !first && !step.accepted;
+void OnlineMatcher::countRejections(OnlineStep& step, const Keyframe* keyframe) {
+  const bool rejected = keyframe && !step.accepted;  // the first scan (no keyframe) is never rejected
   consecutive_rejections_ = rejected ? consecutive_rejections_ + 1 : 0;
   step.consecutive_rejections = consecutive_rejections_;
   step.rejection_alarm = consecutive_rejections_ >= settings_.max_consecutive_rejections;
@@ -344,7 +344,8 @@ void OnlineMatcher::countRejections(OnlineStep& step, bool first) {
 
 void OnlineMatcher::updateChain(OnlineStep& step, const PointArray& points, double stamp,
                                 const std::optional<Eigen::Isometry3d>& odom,
-                                const Keyframe* keyframe, bool first, bool refused) {
+                                const Keyframe* keyframe, bool refused) {
+  const bool first = !keyframe;
   // A known pose (first, accepted, or forced on by the alarm) predicts the next scans.
   const bool known = !refused && (first || step.accepted || (step.rejection_alarm && !points.empty()));
   if (known && !points.empty()) {

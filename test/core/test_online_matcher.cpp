@@ -18,6 +18,15 @@ PointArray scanInBase(const sim::Scene& scene, const Eigen::Isometry3d& body, st
   return sim::scanInBody(scene, sim::ScannerModel{}, body, rng);
 }
 
+/// A scan of hall world 2 from (2, 0.5, 1) m, unturned, in base_link.
+PointArray hallScan() {
+  const sim::Scene scene = sim::Scene::generate(sim::SceneType::Hall, 2);
+  std::mt19937_64 rng(3);
+  Eigen::Isometry3d body = Eigen::Isometry3d::Identity();
+  body.translation() = Eigen::Vector3d(2, 0.5, 1.0);
+  return scanInBase(scene, body, rng);
+}
+
 double translationError(const Eigen::Isometry3d& a, const Eigen::Isometry3d& b) {
   return (a.translation() - b.translation()).norm();
 }
@@ -184,11 +193,7 @@ TEST(OnlineMatcher, CorrectionBoundsGrowWithTheScansTheGuessSpans) {
 // Settings whose grids cannot be built for the current reference are refused at once, and the
 // matcher goes on with the old ones (a live cube_edge far too small must not stop it).
 TEST(OnlineMatcher, SettingsWhoseGridsCannotBeBuiltAreRefusedAndTheOldOnesStay) {
-  const sim::Scene scene = sim::Scene::generate(sim::SceneType::Hall, 2);
-  std::mt19937_64 rng(3);
-  Eigen::Isometry3d body = Eigen::Isometry3d::Identity();
-  body.translation() = Eigen::Vector3d(2, 0.5, 1.0);
-  const PointArray scan = scanInBase(scene, body, rng);
+  const PointArray scan = hallScan();
   OnlineMatcherSettings settings;
   settings.registration.grid.max_cubes = std::uint64_t{1} << 24;
   OnlineMatcher m(settings);
@@ -390,11 +395,7 @@ TEST(OnlineMatcher, ForcedScansWithoutOdometryKeepTheChainFiniteAndRigid) {
 // A step whose pose would not be finite never enters the chain: odometry with a NaN is ignored
 // (the scan is registered as without odometry), and a start pose with one is refused.
 TEST(OnlineMatcher, NonFiniteOdometryIsIgnoredAndANonFiniteStartIsRefused) {
-  const sim::Scene scene = sim::Scene::generate(sim::SceneType::Hall, 2);
-  std::mt19937_64 rng(3);
-  Eigen::Isometry3d body = Eigen::Isometry3d::Identity();
-  body.translation() = Eigen::Vector3d(2, 0.5, 1.0);
-  const PointArray scan = scanInBase(scene, body, rng);
+  const PointArray scan = hallScan();
   OnlineMatcher m{OnlineMatcherSettings{}};
   Eigen::Isometry3d bad = Eigen::Isometry3d::Identity();
   bad.translation().x() = std::numeric_limits<double>::quiet_NaN();

@@ -193,11 +193,12 @@ class OnlineMatcher {
                        double predicted_from, const Keyframe& keyframe);
   /// Sets step.pose; false when the chain guard refused the step (not a finite rigid motion).
   bool placeScan(OnlineStep& step, const Keyframe* keyframe, const Eigen::Isometry3d& predicted);
-  void countRejections(OnlineStep& step, bool first);
+  /// `keyframe`: the reference's frame (null for the first scan of a chain).
+  void countRejections(OnlineStep& step, const Keyframe* keyframe);
   /// The known pose, the velocity, the keyframes and the anchor after this scan.
   void updateChain(OnlineStep& step, const PointArray& points, double stamp,
                    const std::optional<Eigen::Isometry3d>& odom, const Keyframe* keyframe,
-                   bool first, bool refused);
+                   bool refused);
   static void describe(OnlineStep& step);
   /// De-skews an accepted scan with the registered motion over `interval` [s] since
   /// last_known_ into `out`, and registers it once more if the settings say so (keeping the
