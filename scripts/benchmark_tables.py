@@ -585,11 +585,11 @@ def rate(out):
     print()
 
 
-def header(out):
-    path = os.path.join(out, "run.txt")
-    print("# Benchmark tables: %s\n" % out)
+def header(out, section):
+    """The lines of SECTION/run.txt that say where and when its figures were measured."""
+    path = os.path.join(out, section, "run.txt")
     if not os.path.exists(path):
-        print("(no run.txt)\n")
+        print("(no %s/run.txt)\n" % section)
         return
     with open(path) as fh:
         keys = ("mode", "commit", "tree", "started", "cpu", "cores", "finished")
@@ -604,10 +604,11 @@ def main():
     args = parser.parse_args()
     if not os.path.isdir(args.out):
         sys.exit("benchmark_tables: %s is not a directory" % args.out)
-    header(args.out)
+    print("# Benchmark tables: %s\n" % args.out)
     for name in SECTIONS:
         if args.section in (None, name):
             print("## %s\n" % name)
+            header(args.out, name)
             globals()[name](args.out)
 
 

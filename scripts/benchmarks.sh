@@ -1,24 +1,28 @@
 #!/usr/bin/env bash
 # Reruns every benchmark behind a section of BENCHMARK.md on the shipped defaults (no tuning
 # option is given to any tool) and writes each run's CSV and stdout log into
-# OUT_DIR/<section>/ under fixed names, plus OUT_DIR/run.txt: the commit (and whether the tree
-# had changes), the date, the CPU, the core count and the vector paths the tools reported.
+# OUT_DIR/<section>/ under fixed names, plus OUT_DIR/<section>/run.txt: the commit (and whether
+# the tree had changes), the dates, the CPU, the core count and the vector paths the tools
+# reported.
 # scripts/benchmark_tables.py prints BENCHMARK.md's tables from OUT_DIR.
-#   usage: scripts/benchmarks.sh quick|full DATA_DIR [OUT_DIR]
+#   usage: scripts/benchmarks.sh quick|full DATA_DIR [OUT_DIR [SECTION...]]
 # DATA_DIR is laid out like shared/data (sub-folders with pairs.txt; a sequence also has
 # poses.tum); OUT_DIR defaults to docs/results. full: the runs BENCHMARK.md quotes; quick:
 # reduced simulated runs (every tool runs, a first look), and no rate benchmark.
 # Sections (folders of OUT_DIR): real_pairs (accuracy, speed per vector path, stage times),
-# scenes, sequences, sweeps, rate. Each section's folder is emptied before it runs, so one
+# scenes, sequences, sweeps, rate; all of them unless some are named after OUT_DIR (so the
+# timed sections can run on a quiet machine apart from the long untimed ones). Each section's
+# folder is emptied before it runs, so one
 # OUT_DIR never mixes two runs. Steps run one at a time, as the times are part of the results;
 # a failing step does not stop the others: the script lists the failed ones and exits 1.
 set -euo pipefail
 
 usage() {
-  echo "usage: scripts/benchmarks.sh quick|full DATA_DIR [OUT_DIR (default docs/results)]" >&2
+  echo "usage: scripts/benchmarks.sh quick|full DATA_DIR [OUT_DIR (default docs/results)" \
+    "[SECTION... (real_pairs scenes sequences sweeps rate; default all)]]" >&2
   exit 2
 }
-if [ $# -lt 2 ] || [ $# -gt 3 ]; then usage; fi
+if [ $# -lt 2 ]; then usage; fi
 MODE="$1"
 case "$MODE" in quick | full) ;; *) usage ;; esac
 if [ ! -d "$2" ]; then
@@ -29,6 +33,17 @@ fi
 DATA_DIR="$(cd "$2" && pwd)"
 ROOT="$(cd "$(dirname "$0")/.." && pwd)"
 OUT_DIR="${3:-$ROOT/docs/results}"
+SECTIONS=(real_pairs scenes sequences sweeps rate)
+if [ $# -gt 3 ]; then
+  SECTIONS=("${@:4}")
+  for s in "${SECTIONS[@]}"; do
+    case "$s" in real_pairs | scenes | sequences | sweeps | rate) ;; *)
+      echo "benchmarks: unknown section '$s'" >&2
+      usage
+      ;;
+    esac
+  done
+fi
 mkdir -p "$OUT_DIR"
 OUT_DIR="$(cd "$OUT_DIR" && pwd)"
 cd "$ROOT"
@@ -236,8 +251,9 @@ rate() {
   done
 }
 
-# run.txt: what the figures were measured on, completed at the end.
-{
+# SECTION/run.txt, written after the section ran: what its figures were measured on (sections
+# run on different days each say their own commit and dates).
+run_header() {
   echo "mode: $MODE"
   echo "data: $DATA_DIR"
   echo "commit: $COMMIT"
@@ -247,7 +263,7 @@ rate() {
     echo "tree: dirty (tracked files changed, built as they were):"
     echo "$TREE_CHANGES" | sed 's/^/  /'
   fi
-  echo "started: $(date -u '+%Y-%m-%d %H:%M:%S UTC')"
+  echo "started: $1"
   echo "cpu: $(grep -m1 'model name' /proc/cpuinfo | cut -d: -f2- | sed 's/^ //' || true)"
   echo "cores: $(nproc)"
   echo "cpu vector flags: $(grep -m1 '^flags' /proc/cpuinfo | tr ' ' '\n' |
@@ -257,30 +273,29 @@ rate() {
   echo "open3d peers: $OPEN3D"
   echo "CSM_SIMD in the environment: ${CSM_SIMD_GIVEN:-unset} (not passed on: each tool ran" \
     "on its default path unless its step names one)"
-} > "$OUT_DIR/run.txt"
+}
 
-real_pairs
-scenes
-sequences
-sweeps
-rate
-
-# The vector paths the tools reported (the benchmarks' "SIMD path:" line, the nodelet's
-# start message), with the number of logs reporting each.
-{
+# The vector paths the section's tools reported (the benchmarks' "SIMD path:" line, the
+# nodelet's start message), with the number of logs reporting each, and its steps.
+run_footer() {
+  local section="$1" first_step="$2"
   echo "finished: $(date -u '+%Y-%m-%d %H:%M:%S UTC')"
   echo "SIMD paths reported (logs: path):"
-  grep -ho "SIMD path:\? [a-z0-9]* (supported here:[a-z0-9 ]*)" "$OUT_DIR"/*/*.log 2>/dev/null |
-    sed 's/SIMD path:\? //' | sort | uniq -c |
+  grep -ho "SIMD path:\? [a-z0-9]* (supported here:[a-z0-9 ]*)" "$OUT_DIR/$section"/*.log \
+    2>/dev/null | sed 's/SIMD path:\? //' | sort | uniq -c |
     awk '{n = $1; $1 = ""; print "  " n " logs:" $0}' || true
   echo "steps:"
-  printf '  %s\n' "${STEPS[@]}"
-  if [ ${#FAILED[@]} -gt 0 ]; then
-    echo "failed: ${#FAILED[@]}"
-  fi
-} >> "$OUT_DIR/run.txt"
+  printf '  %s\n' "${STEPS[@]:$first_step}"
+}
 
-echo "== results in ${OUT_DIR#"$ROOT/"} (run.txt: commit, machine, steps)"
+for section in "${SECTIONS[@]}"; do
+  first_step=${#STEPS[@]}
+  started="$(date -u '+%Y-%m-%d %H:%M:%S UTC')"
+  "$section"  # empties OUT_DIR/section first
+  { run_header "$started"; run_footer "$section" "$first_step"; } > "$OUT_DIR/$section/run.txt"
+done
+
+echo "== results in ${OUT_DIR#"$ROOT/"} (SECTION/run.txt: commit, machine, steps)"
 if [ ${#FAILED[@]} -gt 0 ]; then
   echo "== ${#FAILED[@]} step(s) failed:" >&2
   printf '   %s\n' "${FAILED[@]}" >&2
