@@ -3,8 +3,9 @@
 # input:=sweeps, ground truth, tf), then replays it in a loop at RATE x through
 # launch/bag_replay.launch into the nodelet for MINUTES, while soak_monitor tracks the manager's
 # resident memory, latency, drops and every registration against the truth. Fails if the
-# manager dies, memory grows (second half's maximum beyond 110 % of the first half's) or
-# nothing is processed. Needs a built package.
+# manager dies, memory grows (second half's maximum beyond 110 % of the first half's), nothing
+# is registered, an accepted increment is off the truth by 10 cm or 1 deg or more, or fewer
+# than 90 % of the registrations are accepted. Needs a built package.
 #   bash scripts/soak.sh [MINUTES] [RATE] [SWEEPS]     (defaults 10, 5, 30)
 set -eo pipefail
 MINUTES="${1:-10}"; RATE="${2:-5}"; SWEEPS="${3:-30}"

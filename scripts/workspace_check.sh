@@ -16,5 +16,9 @@ catkin_make -DCMAKE_BUILD_TYPE=Release -j2 > "$WS/catkin_make.log" 2>&1 ||
 [ -f "$WS/devel/setup.bash" ] || { echo "workspace_check: FAILED: no $WS/devel/setup.bash"; exit 1; }
 [ ! -e "$WS/build/devel" ] || { echo "workspace_check: FAILED: not a catkin_make layout"; exit 1; }
 cd "$WS/build"
-ctest -R "rviz_screenshot|roslaunch-check_launch_scan_matcher" --output-on-failure
+TESTS="rviz_screenshot|roslaunch-check_launch_scan_matcher"
+# Both tests must exist: a renamed one would otherwise leave the other passing alone.
+found="$(ctest -N -R "$TESTS" | sed -n 's/^Total Tests: //p')"
+[ "$found" = 2 ] || { echo "workspace_check: FAILED: $found tests match '$TESTS', expected 2"; exit 1; }
+ctest -R "$TESTS" --no-tests=error --output-on-failure
 echo "workspace_check: OK ($WS: devel/ beside build/)"

@@ -286,61 +286,49 @@ double rotationAngle(const Eigen::Matrix3d& R) {
   return Eigen::AngleAxisd(R).angle();
 }
 
-}  // namespace
+/// Where the Gauss-Newton rounds of the polish end.
+struct Iterated {
+  Eigen::Matrix3d R;
+  Eigen::Vector3d t;
+  int iterations = 0;
+};
 
-PolishResult polishOnPlanes(const PlaneMap& map, const PointArray& scan, const Pose6& pose,
-                            const PolishSettings& s) {
-  PolishResult res;
-  res.pose = pose;
-  if (scan.empty() || map.voxels() == 0 || !pose.allFinite()) {
-    res.reason = "no points or no planes";
-    return res;
-  }
-  const Eigen::Isometry3d T0 = poseToIsometry(pose);
-  Eigen::Matrix3d R = T0.linear();
-  Eigen::Vector3d t = T0.translation();
-  // Radius of gyration about the scan's origin of the points near a plane at the start (far
-  // outliers have none): the lever arm that makes a rotation comparable with a translation.
-  double rho = 1.0;
-
-  // Rounds: each starts with a pass over every scan point that collects those near a plane,
-  // then iterates on them alone (the pose moves by millimetres). A round ends when it
-  // converges, or after round_steps steps (the set was collected where the pose no longer is);
-  // the polish ends after a converged round that started at a converged pose, so the final
-  // set is collected at the result and does not depend on the start.
-  Linearisation L;
-  bool converged = false;  // the last step was below the tolerances: L still holds there
-  int it = 0;
-  // Reused from call to call: a fresh correspondence list of a few thousand rows would be
-  // faulted in page by page at every registration (~10 us per page fault on a VM).
-  thread_local PointArray near;
+/// The Gauss-Newton rounds from (R, t). Each round starts with a pass over every scan point
+/// that collects those near a plane into `near`, then iterates on them alone (the pose moves
+/// by millimetres). A round ends when it converges, or after round_steps steps (the set was
+/// collected where the pose no longer is); the polish ends after a converged round that
+/// started at a converged pose, so the final set is collected at the result and does not
+/// depend on the start. Correspondences are trilinear (lineariseTrilinear), so the objective is
+/// continuous in the pose. `rho` gets the lever arm of the first round's points.
+Iterated iterate(const PlaneMap& map, const PointArray& scan, const Eigen::Isometry3d& start,
+                 const PolishSettings& s, PointArray& near, double& rho) {
+  Iterated res{start.linear(), start.translation(), 0};
+  Eigen::Matrix3d& R = res.R;
+  Eigen::Vector3d& t = res.t;
+  int& it = res.iterations;
+  // Reused from call to call: fresh corner lists of a few thousand entries would be faulted in
+  // page by page at every registration (~10 us per page fault on a VM). The first round's
+  // corners stay valid as a cache for the second round's collecting pass (the pose has moved
+  // by centimetres at most).
   thread_local std::vector<Corners> all_corners, near_corners;
-  thread_local std::vector<Row> rows;
-  // A collecting pass runs over every scan point and fills `near`; the others over `near`.
-  auto lineariseAt = [&](bool collect) {
-    if (!s.trilinear) return linearise(map, collect ? scan : near, R, t, s.kernel, collect ? &near : nullptr);
-    if (!collect) return lineariseTrilinear(map, near, R, t, s.kernel, near_corners);
-    // The first round's corners stay valid as a cache for the second round's collecting pass
-    // (the pose has moved by centimetres at most).
-    if (it == 0) all_corners.assign(scan.size(), Corners());
-    return lineariseTrilinear(map, scan, R, t, s.kernel, all_corners,
-                              &near, &near_corners);
-  };
+  all_corners.assign(scan.size(), Corners());
   double stretch = 1.0;  // over-relaxation of the last step
   Vector6 last_dx = Vector6::Zero();
   bool started_converged = false;  // this round collected its points at a converged pose
   while (it < s.max_iterations) {
     near.clear();
     near_corners.clear();
-    converged = false;
+    bool converged = false;
     bool cut = false;  // the round ran its round_steps steps without converging
     for (int round_it = 0; it < s.max_iterations; ++round_it) {
       if (s.round_steps > 0 && round_it >= s.round_steps) {
         cut = true;
         break;
       }
-      const bool collect = round_it == 0;
-      L = lineariseAt(collect);
+      const bool collect = round_it == 0;  // a pass over every scan point, filling `near`
+      const Linearisation L =
+          collect ? lineariseTrilinear(map, scan, R, t, s.kernel, all_corners, &near, &near_corners)
+                  : lineariseTrilinear(map, near, R, t, s.kernel, near_corners);
       if (L.count < s.min_correspondences) break;
       if (it == 0) rho = radiusOfGyration(near);
       const Vector6 dx = step(L, spectrum(L.H, rho), s.weak_ratio);
@@ -354,7 +342,7 @@ PolishResult polishOnPlanes(const PlaneMap& map, const PointArray& scan, const P
       t += stretch * dx.head<3>();
       const Eigen::Vector3d w = stretch * dx.tail<3>();
       if (w.norm() > 0.0) R = Eigen::AngleAxisd(w.norm(), w.normalized()).toRotationMatrix() * R;
-      res.iterations = ++it;
+      ++it;
       if (dx.head<3>().norm() < s.tolerance_m && dx.tail<3>().norm() < s.tolerance_rad) {
         converged = true;
         break;
@@ -363,31 +351,14 @@ PolishResult polishOnPlanes(const PlaneMap& map, const PointArray& scan, const P
     if ((!converged && !cut) || (converged && started_converged)) break;
     started_converged = converged;
   }
-  // The covariance and the weak axes from each point's own voxel's plane (with the trilinear
-  // pairs, a floor point near a wall would also meet the wall's plane: a residual of the
-  // corner's geometry, not of the pose, which would widen the covariance).
-  rows.clear();
-  L = linearise(map, near.empty() ? scan : near, R, t, s.kernel, nullptr, &rows);
-  res.correspondences = L.count;
-  if (L.count < s.min_correspondences || L.weight <= 6.0) {
-    res.reason = "too few points near a reference plane";
-    return res;
-  }
-  res.shift_m = (t - T0.translation()).norm();
-  res.shift_rad = rotationAngle(R * T0.linear().transpose());
-  if (!(res.shift_m <= s.max_shift_m) || !(res.shift_rad <= s.max_shift_rad)) {
-    res.reason = "the polish left the cube result's basin";
-    return res;
-  }
-  Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
-  T.linear() = R;
-  T.translation() = t;
-  res.pose = isometryToPose(T);
-  res.applied = true;
-  res.rms = std::sqrt(L.weighted_r2 / L.weight);
+  return res;
+}
 
-  // Covariance sigma^2 H^-1 (sigma^2 from the weighted residuals), weak directions included
-  // with their (large) variance; eigenvalues are floored so that the inverse stays finite.
+/// The covariance sigma^2 H^-1 (sigma^2 from the weighted residuals, times covariance_scale),
+/// weak directions included with their (large) variance, plus the clustered term; sets the
+/// result's weak direction and ratio. Eigenvalues are floored so that the inverse stays finite.
+void setCovariance(const Linearisation& L, const std::vector<Row>& rows, double rho,
+                   const PolishSettings& s, PolishResult& res) {
   const Spectrum sp = spectrum(L.H, rho);
   const double sigma2 = L.weighted_r2 / (L.weight - 6.0);
   Matrix6 inv_s = Matrix6::Zero();
@@ -405,11 +376,16 @@ PolishResult polishOnPlanes(const PlaneMap& map, const PointArray& scan, const P
   }
   res.weak_ratio = sp.max_eigenvalue > 0.0 ? sp.eig.eigenvalues()(0) / sp.max_eigenvalue : 0.0;
   res.weak_direction = sp.eig.eigenvectors().col(0);
+}
 
-  // Translation alone: the normals' information sum w n n^T along its eigenvectors, counted
-  // only from the planes that lean towards each by support_cosine. In a tunnel the fitted
-  // normals' small tilts (and a few fits across a corner) would otherwise give its axis 0.3-2 %
-  // of the floor's information, a 1-2 cm sd and a wrong pose accepted 1-2 m along the axis.
+/// Translation alone: the normals' information sum w n n^T along its eigenvectors, counted only
+/// from the planes that lean towards each by support_cosine. In a tunnel the fitted normals'
+/// small tilts (and a few fits across a corner) would otherwise give its axis 0.3-2 % of the
+/// floor's information, a 1-2 cm sd and a wrong pose accepted 1-2 m along the axis. Sets the
+/// translation's weak axis and ratio, floors the covariance along that axis, and the
+/// degenerate flag.
+void checkTranslation(const Linearisation& L, const std::vector<Row>& rows,
+                      const PolishSettings& s, PolishResult& res) {
   const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> et(L.H.topLeftCorner<3, 3>());
   Eigen::Vector3d t_info = Eigen::Vector3d::Zero();
   for (const Row& row : rows) {
@@ -429,6 +405,7 @@ PolishResult polishOnPlanes(const PlaneMap& map, const PointArray& scan, const P
   // nothing fixes the pose along it (the cube stages leave it near the guess, whose error the
   // scan cannot tell) at least degenerate_sigma_m^2.
   const bool translation_degenerate = res.translation_weak_ratio < s.translation_degenerate_ratio;
+  const double sigma2 = L.weighted_r2 / (L.weight - 6.0);
   const double t_floor = std::max(t_info.maxCoeff() * 1e-12, 1e-300);
   double min_var = s.covariance_scale * sigma2 / std::max(t_info(t_weakest), t_floor);
   if (translation_degenerate) min_var = std::max(min_var, s.degenerate_sigma_m * s.degenerate_sigma_m);
@@ -438,6 +415,52 @@ PolishResult polishOnPlanes(const PlaneMap& map, const PointArray& scan, const P
     res.weak_direction << u, 0.0, 0.0, 0.0;  // the axis the scene does not fix
   }
   res.degenerate = res.weak_ratio < s.degenerate_ratio || translation_degenerate;
+}
+
+}  // namespace
+
+PolishResult polishOnPlanes(const PlaneMap& map, const PointArray& scan, const Pose6& pose,
+                            const PolishSettings& s) {
+  PolishResult res;
+  res.pose = pose;
+  if (scan.empty() || map.voxels() == 0 || !pose.allFinite()) {
+    res.reason = "no points or no planes";
+    return res;
+  }
+  const Eigen::Isometry3d T0 = poseToIsometry(pose);
+  // The radius of gyration about the scan's origin of the points near a plane at the start (far
+  // outliers have none): the lever arm that makes a rotation comparable with a translation.
+  double rho = 1.0;
+  thread_local PointArray near;  // reused: see iterate()
+  const Iterated end = iterate(map, scan, T0, s, near, rho);
+  res.iterations = end.iterations;
+
+  // The covariance and the weak axes from each point's own voxel's plane (with the trilinear
+  // pairs, a floor point near a wall would also meet the wall's plane: a residual of the
+  // corner's geometry, not of the pose, which would widen the covariance).
+  thread_local std::vector<Row> rows;
+  rows.clear();
+  const Linearisation L = linearise(map, near.empty() ? scan : near, end.R, end.t, s.kernel,
+                                    nullptr, &rows);
+  res.correspondences = L.count;
+  if (L.count < s.min_correspondences || L.weight <= 6.0) {
+    res.reason = "too few points near a reference plane";
+    return res;
+  }
+  res.shift_m = (end.t - T0.translation()).norm();
+  res.shift_rad = rotationAngle(end.R * T0.linear().transpose());
+  if (!(res.shift_m <= s.max_shift_m) || !(res.shift_rad <= s.max_shift_rad)) {
+    res.reason = "the polish left the cube result's basin";
+    return res;
+  }
+  Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
+  T.linear() = end.R;
+  T.translation() = end.t;
+  res.pose = isometryToPose(T);
+  res.applied = true;
+  res.rms = std::sqrt(L.weighted_r2 / L.weight);
+  setCovariance(L, rows, rho, s, res);
+  checkTranslation(L, rows, s, res);
   return res;
 }
 

@@ -44,7 +44,6 @@ void configToSettings(const ScanMatcherConfig& c, OnlineMatcherSettings& m) {
   r.search.threads = c.threads;
   r.collapse_fraction = c.collapse_fraction;
   r.dense_points = c.dense_points;
-  r.coarse_max_points = c.coarse_max_points;
   r.refine.enabled = c.refine;
   r.refine.edge_fraction = c.refine_edge_fraction;
   r.refine.grids = c.refine_grids;
@@ -53,10 +52,6 @@ void configToSettings(const ScanMatcherConfig& c, OnlineMatcherSettings& m) {
   r.polish.enabled = c.polish;
   r.polish.voxel_fraction = c.polish_voxel_fraction;
   r.polish.kernel = c.polish_kernel;
-  r.polish.covariance_scale = c.covariance_scale;
-  r.polish.covariance_cell_m = c.covariance_cell;
-  r.polish.covariance_cell_scale = c.covariance_cell_scale;
-  r.polish.covariance_jackknife_cap = c.covariance_jackknife;
   m.gate.min_overlap = c.min_overlap;
   m.gate.max_correction_m = c.max_correction_translation;
   m.gate.max_correction_rad = deg2rad(c.max_correction_rotation);
@@ -134,7 +129,6 @@ ScanMatcherConfig toConfig(const NodeParams& p) {
   c.threads = r.search.threads;
   c.collapse_fraction = r.collapse_fraction;
   c.dense_points = r.dense_points;
-  c.coarse_max_points = r.coarse_max_points;
   c.refine = r.refine.enabled;
   c.refine_edge_fraction = r.refine.edge_fraction;
   c.refine_grids = r.refine.grids;
@@ -143,10 +137,6 @@ ScanMatcherConfig toConfig(const NodeParams& p) {
   c.polish = r.polish.enabled;
   c.polish_voxel_fraction = r.polish.voxel_fraction;
   c.polish_kernel = r.polish.kernel;
-  c.covariance_scale = r.polish.covariance_scale;
-  c.covariance_cell = r.polish.covariance_cell_m;
-  c.covariance_cell_scale = r.polish.covariance_cell_scale;
-  c.covariance_jackknife = r.polish.covariance_jackknife_cap;
   c.min_overlap = p.matcher.gate.min_overlap;
   c.max_correction_translation = p.matcher.gate.max_correction_m;
   c.max_correction_rotation = rad2deg(p.matcher.gate.max_correction_rad);

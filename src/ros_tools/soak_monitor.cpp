@@ -4,8 +4,11 @@
 // ground truth, including whether each gate rejection was right (the rejected result really
 // was off) or wrong (the result was right and the gate threw it away).
 //   rosrun cube_scan_matcher soak_monitor _duration:=600 _pid:=1234 [_matcher_ns:=scan_matcher]
+//     [_max_accepted_wrong:=0] [_min_accepted_share:=0.9]
 // Exit code 0 when the process lived to the end, memory stayed flat (the maximum over the
-// second half within 10 % of the first half's) and scans were processed; 1 otherwise.
+// second half within 10 % of the first half's), scans were registered, at most
+// max_accepted_wrong accepted increments were off the truth (by 10 cm or 1 deg or more) and at
+// least min_accepted_share of the registrations with a truth were accepted; 1 otherwise.
 #include <algorithm>
 #include <cstdio>
 #include <fstream>
@@ -111,6 +114,8 @@ int main(int argc, char** argv) {
   const double duration = pnh.param("duration", 600.0);
   const int pid = pnh.param("pid", 0);
   const std::string ns = pnh.param<std::string>("matcher_ns", "scan_matcher");
+  const int max_accepted_wrong = pnh.param("max_accepted_wrong", 0);
+  const double min_accepted_share = pnh.param("min_accepted_share", 0.9);
   if (pid <= 0 || residentMegabytes(pid) < 0) {
     std::fprintf(stderr, "soak_monitor: ~pid must be the running matcher's process id, got %d\n", pid);
     return 1;
@@ -184,7 +189,14 @@ int main(int argc, char** argv) {
   std::printf("soak: resident memory %.1f-%.1f MB; max first half %.1f MB, second half %.1f MB (%s)\n",
               rss_min, std::max(first_max, second_max), first_max, second_max,
               flat ? "flat: within 10 %" : "GROWING: beyond 10 %");
-  const bool ok = alive && flat && m.statuses > 0;
+  const int judged = m.accepted + m.rejected_right + m.rejected_wrong + m.rejected_unregistered;
+  const bool right = m.accepted_wrong <= max_accepted_wrong;
+  const bool enough = judged > 0 && m.accepted >= min_accepted_share * judged;
+  std::printf("soak: %d of %d registrations accepted (%.1f %%, at least %.0f %% needed); %d accepted "
+              "off (at most %d allowed)\n",
+              m.accepted, judged, judged ? 100.0 * m.accepted / judged : 0.0, 100.0 * min_accepted_share,
+              m.accepted_wrong, max_accepted_wrong);
+  const bool ok = alive && flat && m.statuses > 0 && right && enough;
   std::printf("soak: %s\n", ok ? "PASSED" : "FAILED");
   return ok ? 0 : 1;
 }

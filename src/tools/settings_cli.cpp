@@ -67,8 +67,6 @@ std::string algorithmOptionsHelp() {
          "  --polish-weak R       the polish does not move along directions with less than R x\n"
          "                        the strongest information (default " + num(d.polish.weak_ratio) + ")\n"
          "  --polish-iterations N Gauss-Newton steps of the polish (default " + std::to_string(d.polish.max_iterations) + ")\n"
-         "  --polish-trilinear B  1: each point meets the planes of the 8 voxels around it,\n"
-         "                        trilinearly weighted; 0: its own voxel's plane (default " + std::to_string(int(d.polish.trilinear)) + ")\n"
          "  --polish-overrelax F  a polish step along the last one's direction is stretched\n"
          "                        up to F times, 1 = plain Gauss-Newton (default " + num(d.polish.max_overrelaxation) + ")\n"
          "  --polish-round-steps N  steps per round of the polish before its points are\n"
@@ -159,8 +157,6 @@ bool parseAlgorithmOption(const std::vector<std::string>& args, std::size_t& i,
     s.polish.weak_ratio = value(1), used = 2;
   } else if (a == "--polish-iterations") {
     s.polish.max_iterations = int(value(1)), used = 2;
-  } else if (a == "--polish-trilinear") {
-    s.polish.trilinear = value(1) != 0.0, used = 2;
   } else if (a == "--polish-overrelax") {
     s.polish.max_overrelaxation = value(1), used = 2;
   } else if (a == "--polish-max-shift") {

@@ -9,6 +9,7 @@
 
 #include "cube_scan_matcher/core/cube_grid.h"
 #include "cube_scan_matcher/core/simd_path.h"
+#include "simd_test_paths.h"
 #include "grid_test_helpers.h"
 
 using namespace cube_scan_matcher;
@@ -126,7 +127,7 @@ TEST(SimdPath, EveryPathGivesTheIndicesOfThePortableOne) {
   // Random rotations and translations, points inside, outside, on cube faces (x.5 after the
   // affine's +0.5) and non-finite: every vector path must write the same indices.
   SimdPathGuard guard;
-  const std::vector<SimdPath> paths = supportedSimdPaths();
+  const std::vector<SimdPath> paths = simdPathsToCompare();
   ASSERT_FALSE(paths.empty());
   EXPECT_EQ(paths.back(), SimdPath::Portable);
   PointArray ref;

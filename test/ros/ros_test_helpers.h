@@ -2,9 +2,12 @@
 // loop with a timeout, and a cloud from a PointArray.
 #pragma once
 
+#include <algorithm>
+#include <cstdio>
 #include <string>
 #include <vector>
 
+#include <Eigen/Geometry>
 #include <geometry_msgs/PoseWithCovarianceStamped.h>
 #include <nav_msgs/Odometry.h>
 #include <nav_msgs/Path.h>
@@ -16,6 +19,23 @@
 #include "cube_scan_matcher/ros/cloud_conversion.h"
 
 namespace cube_scan_matcher::test {
+
+/// The largest pose error a test binary met, printed when it exits: the tolerances of its
+/// checks are set near twice these (a real regression must fail them), and the log says how
+/// close each run came.
+struct WorstError {
+  double m = 0.0, deg = 0.0;
+  int checked = 0;
+  void add(const Eigen::Isometry3d& error) {
+    ++checked;
+    m = std::max(m, error.translation().norm());
+    deg = std::max(deg, Eigen::AngleAxisd(error.linear()).angle() * 180.0 / M_PI);
+  }
+  ~WorstError() {
+    if (checked > 0)
+      std::printf("largest pose error of %d checked: %.4f m / %.4f deg\n", checked, m, deg);
+  }
+};
 
 /// Every message of each output of the matcher whose private namespace is `ns` ("/name/").
 struct Outputs {

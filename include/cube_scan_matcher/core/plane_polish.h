@@ -36,12 +36,6 @@ struct PolishSettings {
   /// Stop when a step moves less than these [m], [rad].
   double tolerance_m = 5e-4;
   double tolerance_rad = 1e-4;
-  /// Trilinear correspondences: a scan point is paired with the planes of the 8 voxels whose
-  /// centres surround it, weighted by its trilinear weights, so the objective is continuous in
-  /// the pose and the result does not depend on the start (the corridor pair's 25 starts: 2-6
-  /// mm / 0.03-0.08 deg apart with one plane per point, 0.1-0.2 mm / 0.001-0.003 deg with 8).
-  /// false: the plane of the point's own voxel only.
-  bool trilinear = true;
   /// Over-relaxation: a step that keeps the previous step's direction (cosine > 0.8 in units
   /// where 1 rad = 1 m at the scan's radius of gyration) is taken 1.5 times as long as the
   /// previous one was stretched, up to this factor; any other step as computed. The robust
