@@ -16,6 +16,7 @@
 #include "cube_scan_matcher/ros/cloud_conversion.h"
 #include "cube_scan_matcher/ros/transforms.h"
 #include "cube_scan_matcher/sim/motion.h"
+#include "arg_reader.h"
 
 using namespace cube_scan_matcher;
 
@@ -39,37 +40,29 @@ const char* kUsage =
 }  // namespace
 
 int main(int argc, char** argv) {
-  std::vector<std::string> args(argv + 1, argv + argc);
-  if (args.empty() || args[0] == "-h" || args[0] == "--help") {
+  tools::ArgReader r(argc, argv);
+  if (argc < 2 || r.help()) {
     std::cout << kUsage;
-    return args.empty() ? 1 : 0;
+    return argc < 2 ? 1 : 0;
   }
   try {
-    const std::string output = args[0];
+    const std::string output = r.positional();
     std::vector<std::string> clouds;
     std::vector<Eigen::Isometry3d> poses;
     std::string dataset, poses_file, topic = "assembled_cloud", frame = "base_link", odom_frame = "odom";
     double rate = 1.0, start = 1000.0, err_t = 0.0, err_a = 0.0;
     std::uint64_t seed = 1;
-    for (std::size_t i = 1; i < args.size(); ++i) {
-      const std::string& a = args[i];
-      auto value = [&]() -> std::string {
-        if (i + 1 >= args.size()) throw std::invalid_argument(a + ": missing value");
-        return args[++i];
-      };
-      if (a == "--dataset") dataset = value();
-      else if (a == "--poses") poses_file = value();
-      else if (a == "--rate") rate = io::parseNumber(a, value());
-      else if (a == "--start") start = io::parseNumber(a, value());
-      else if (a == "--topic") topic = value();
-      else if (a == "--frame") frame = value();
-      else if (a == "--odom-frame") odom_frame = value();
-      else if (a == "--seed") seed = std::uint64_t(io::parseNumber(a, value()));
-      else if (a == "--odometry-error") {
-        err_t = io::parseNumber(a, value());
-        err_a = io::parseNumber(a, value());
-      } else if (a.rfind("--", 0) == 0) throw std::invalid_argument("unknown option " + a);
-      else clouds.push_back(a);
+    while (r.more()) {
+      if (r.option("--dataset", dataset) || r.option("--poses", poses_file) ||
+          r.option("--rate", rate) || r.option("--start", start) || r.option("--topic", topic) ||
+          r.option("--frame", frame) || r.option("--odom-frame", odom_frame) ||
+          r.option("--seed", seed) ||
+          r.optionWith("--odometry-error", 2, [&](const std::vector<std::string>& v) {
+            err_t = io::parseNumber("--odometry-error", v[0]);
+            err_a = io::parseNumber("--odometry-error", v[1]);
+          }))
+        continue;
+      clouds.push_back(r.positional());
     }
     if (!(rate > 0.0)) throw std::invalid_argument("--rate must be > 0");
     if (!(start > 0.0)) throw std::invalid_argument("--start must be > 0 (a zero stamp means no time)");

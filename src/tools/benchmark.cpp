@@ -6,7 +6,6 @@
 #include <cmath>
 #include <chrono>
 #include <cstdio>
-#include <fstream>
 #include <functional>
 #include <memory>
 #include <iostream>
@@ -24,6 +23,8 @@
 #include "cube_scan_matcher/io/dataset.h"
 #include "open3d_peers.h"
 #include "peer_methods.h"
+#include "arg_reader.h"
+#include "csv_writer.h"
 #include "settings_cli.h"
 
 using namespace cube_scan_matcher;
@@ -83,14 +84,11 @@ struct Row {
   Eigen::Isometry3d estimate = Eigen::Isometry3d::Identity();  // the method's T_target_source
 };
 
-/// "tx,ty,tz,qx,qy,qz,qw" with every digit (17 significant): results compare bit for bit.
-std::string poseCsv(const Eigen::Isometry3d& T) {
+/// The cells tx,ty,tz,qx,qy,qz,qw with every digit: results compare bit for bit.
+void writePose(CsvWriter& csv, const Eigen::Isometry3d& T) {
   const Eigen::Quaterniond q(T.linear());
-  std::ostringstream os;
-  os.precision(17);
-  os << T.translation().x() << ',' << T.translation().y() << ',' << T.translation().z() << ','
-     << q.x() << ',' << q.y() << ',' << q.z() << ',' << q.w();
-  return os.str();
+  csv << Exact{T.translation().x()} << Exact{T.translation().y()} << Exact{T.translation().z()}
+      << Exact{q.x()} << Exact{q.y()} << Exact{q.z()} << Exact{q.w()};
 }
 
 struct Bounds {
@@ -101,7 +99,6 @@ struct Bounds {
 }  // namespace
 
 int main(int argc, char** argv) {
-  std::vector<std::string> args(argv + 1, argv + argc);
   RegistrationSettings cube_settings = RegistrationSettings{};
   RangeFilterSettings filter;
   std::string dir, csv_path = "benchmark.csv";
@@ -112,57 +109,43 @@ int main(int argc, char** argv) {
   std::vector<double> edges;
   std::vector<Bounds> bounds = {{"big", 1.0, 8.0}};
   try {
-    for (std::size_t i = 0; i < args.size();) {
-      const std::string& a = args[i];
-      auto next = [&]() -> std::string {
-        if (i + 1 >= args.size()) throw std::invalid_argument(a + ": missing value");
-        i += 2;
-        return args[i - 1];
-      };
-      if (a == "-h" || a == "--help") {
+    auto bounds_of = [&](const std::string& b) {
+      if (b == "big") bounds = {{"big", 1.0, 8.0}};
+      else if (b == "small") bounds = {{"small", 0.25, 2.0}};
+      else if (b == "both") bounds = {{"big", 1.0, 8.0}, {"small", 0.25, 2.0}};
+      else throw std::invalid_argument("--initial-errors: expected big, small or both");
+    };
+    auto methods_of = [&](const std::string& m) {
+      methods = m == "all" ? kAllMethods : splitList(m);
+      for (const auto& name : methods) {
+        const bool o3d =
+            std::find(kOpen3dMethods.begin(), kOpen3dMethods.end(), name) != kOpen3dMethods.end();
+        if (o3d && !open3dAvailable())
+          throw std::invalid_argument("--methods " + name + ": this build has no Open3D");
+        const bool extra =
+            std::find(kExtraMethods.begin(), kExtraMethods.end(), name) != kExtraMethods.end();
+        if (!o3d && !extra &&
+            std::find(kAllMethods.begin(), kAllMethods.end(), name) == kAllMethods.end())
+          throw std::invalid_argument("--methods: unknown method '" + name + "'");
+      }
+    };
+    auto edges_of = [&](const std::string& list) {
+      edges.clear();
+      for (const auto& e : splitList(list)) edges.push_back(parseNumber("--edges", e));
+    };
+    for (ArgReader r(argc, argv); r.more();) {
+      if (r.help()) {
         usage(std::cout);
         return 0;
       }
-      if (parseAlgorithmOption(args, i, cube_settings, filter)) continue;
-      if (a == "--trials") {
-        trials = int(parseNumber(a, next()));
-      } else if (a == "--initial-errors") {
-        const std::string b = next();
-        if (b == "big") bounds = {{"big", 1.0, 8.0}};
-        else if (b == "small") bounds = {{"small", 0.25, 2.0}};
-        else if (b == "both") bounds = {{"big", 1.0, 8.0}, {"small", 0.25, 2.0}};
-        else throw std::invalid_argument("--initial-errors: expected big, small or both");
-      } else if (a == "--methods") {
-        const std::string m = next();
-        methods = m == "all" ? kAllMethods : splitList(m);
-        for (const auto& name : methods) {
-          const bool o3d =
-              std::find(kOpen3dMethods.begin(), kOpen3dMethods.end(), name) != kOpen3dMethods.end();
-          if (o3d && !open3dAvailable())
-            throw std::invalid_argument("--methods " + name + ": this build has no Open3D");
-          const bool extra =
-              std::find(kExtraMethods.begin(), kExtraMethods.end(), name) != kExtraMethods.end();
-          if (!o3d && !extra &&
-              std::find(kAllMethods.begin(), kAllMethods.end(), name) == kAllMethods.end())
-            throw std::invalid_argument("--methods: unknown method '" + name + "'");
-        }
-      } else if (a == "--edges") {
-        edges.clear();
-        for (const auto& e : splitList(next())) edges.push_back(parseNumber("--edges", e));
-      } else if (a == "--voxel") {
-        voxel = parseNumber(a, next());
-      } else if (a == "--trial-seed") {
-        trial_seed = unsigned(parseNumber(a, next()));
-      } else if (a == "--csv") {
-        csv_path = next();
-      } else if (a == "--require-success") {
-        require = int(parseNumber(a, next()));
-      } else if (a.rfind("--", 0) == 0) {
-        throw std::invalid_argument("unknown option " + a);
-      } else {
-        if (!dir.empty()) throw std::invalid_argument("more than one DATASET_DIR given");
-        dir = args[i++];
-      }
+      if (r.algorithm(cube_settings, filter) || r.option("--trials", trials) ||
+          r.optionWith("--initial-errors", bounds_of) || r.optionWith("--methods", methods_of) ||
+          r.optionWith("--edges", edges_of) || r.option("--voxel", voxel) ||
+          r.option("--trial-seed", trial_seed) || r.option("--csv", csv_path) ||
+          r.option("--require-success", require))
+        continue;
+      if (!dir.empty()) throw std::invalid_argument("more than one DATASET_DIR given");
+      dir = r.positional();
     }
     if (dir.empty()) {
       usage(std::cerr);
@@ -248,10 +231,10 @@ int main(int argc, char** argv) {
     }
 
     const std::vector<PairEntry> pairs = readPairs(dir);
-    std::ofstream csv(csv_path);
-    if (!csv) throw std::runtime_error(csv_path + ": cannot write");
-    csv << "pair,bounds,method,trial,Es_m,Ea_deg,time_s,evaluations,J,J_ref,time_coarse_s,"
-           "time_refine_s,time_polish_s,polish_iterations,weak_ratio,sigma_m,tx,ty,tz,qx,qy,qz,qw\n";
+    CsvWriter csv(csv_path,
+                  "pair,bounds,method,trial,Es_m,Ea_deg,time_s,evaluations,J,J_ref,time_coarse_s,"
+                  "time_refine_s,time_polish_s,polish_iterations,weak_ratio,sigma_m,tx,ty,tz,qx,"
+                  "qy,qz,qw");
     std::vector<Row> rows;
     const std::size_t total = pairs.size() * bounds.size() * std::size_t(trials) * table.size();
     std::size_t done = 0;
@@ -288,11 +271,12 @@ int main(int argc, char** argv) {
             row.es = err.es_m;
             row.ea = err.ea_deg;
             rows.push_back(row);
-            csv << row.pair << ',' << row.bounds << ',' << row.method << ',' << row.trial << ','
-                << row.es << ',' << row.ea << ',' << row.time << ',' << row.evaluations << ','
-                << row.j << ',' << row.j_ref << ',' << row.time_coarse << ','
-                << row.time_refine << ',' << row.time_polish << ',' << row.polish_iterations << ',' << row.weak_ratio << ',' << row.sigma_m << ','
-                << poseCsv(row.estimate) << '\n';
+            csv << row.pair << row.bounds << row.method << row.trial << row.es << row.ea
+                << row.time << row.evaluations << row.j << row.j_ref << row.time_coarse
+                << row.time_refine << row.time_polish << row.polish_iterations << row.weak_ratio
+                << row.sigma_m;
+            writePose(csv, row.estimate);
+            csv.endRow();
             ++done;
             const double el = std::chrono::duration<double>(std::chrono::steady_clock::now() -
                                                             bench_start).count();

@@ -12,21 +12,20 @@
 #include "cube_scan_matcher/core/registration.h"
 #include "cube_scan_matcher/io/dataset.h"
 #include "cube_scan_matcher/sim/tilting_scanner.h"
+#include "arg_reader.h"
 #include "settings_cli.h"
 
 using namespace cube_scan_matcher;
 
 int main(int argc, char** argv) {
-  std::vector<std::string> args(argv + 1, argv + argc);
   std::string scene_name = "hall";
   std::uint64_t seed = 1;
   double step = 1.5;
   int dense = 4;
   std::vector<double> starts = {10, 30, 50, 70, 90};
   try {
-    for (std::size_t i = 0; i < args.size(); i += 2) {
-      const std::string& a = args[i];
-      if (a == "-h" || a == "--help") {
+    for (tools::ArgReader r(argc, argv); r.more();) {
+      if (r.help()) {
         std::cout << "usage: objective_profile [--scene NAME] [--seed N] [--step M] [--x LIST]\n"
                      "                         [--dense-points N]\n"
                      "  J (E = 0.5 m, default collapse) of the second sweep laid at x = -0.5..1.5\n"
@@ -35,16 +34,14 @@ int main(int argc, char** argv) {
                      "  points of E-cubes holding >= N points (default 4)\n";
         return 0;
       }
-      if (i + 1 >= args.size()) throw std::invalid_argument(a + ": missing value");
-      const std::string& v = args[i + 1];
-      if (a == "--scene") scene_name = v;
-      else if (a == "--seed") seed = std::uint64_t(io::parseNumber(a, v));
-      else if (a == "--step") step = io::parseNumber(a, v);
-      else if (a == "--dense-points") dense = int(io::parseNumber(a, v));
-      else if (a == "--x") {
-        starts.clear();
-        for (const std::string& x : tools::splitList(v)) starts.push_back(io::parseNumber(a, x));
-      } else throw std::invalid_argument("unknown option: " + a);
+      if (r.option("--scene", scene_name) || r.option("--seed", seed) ||
+          r.option("--step", step) || r.option("--dense-points", dense) ||
+          r.optionWith("--x", [&](const std::string& v) {
+            starts.clear();
+            for (const std::string& x : tools::splitList(v)) starts.push_back(io::parseNumber("--x", x));
+          }))
+        continue;
+      r.unknown();
     }
     const sim::Scene scene = sim::Scene::generate(sim::sceneTypeFromString(scene_name), seed);
     const sim::ScannerModel model;

@@ -8,8 +8,8 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
-#include <fstream>
 #include <iostream>
+#include <optional>
 #include <random>
 #include <string>
 #include <vector>
@@ -18,6 +18,8 @@
 #include "cube_scan_matcher/core/registration.h"
 #include "cube_scan_matcher/sim/motion.h"
 #include "cube_scan_matcher/sim/tilting_scanner.h"
+#include "arg_reader.h"
+#include "csv_writer.h"
 #include "settings_cli.h"
 
 using namespace cube_scan_matcher;
@@ -38,7 +40,6 @@ sim::ScannerModel scaledScanner(std::size_t default_points, std::size_t target) 
 }  // namespace
 
 int main(int argc, char** argv) {
-  std::vector<std::string> args(argv + 1, argv + argc);
   std::string scene_name = "urban";
   std::vector<std::size_t> sizes = {10000, 20000, 50000, 100000, 200000, 300000};
   int trials = 10;
@@ -48,9 +49,8 @@ int main(int argc, char** argv) {
   RegistrationSettings settings = RegistrationSettings{};
   RangeFilterSettings filter;
   try {
-    for (std::size_t i = 0; i < args.size();) {
-      const std::string& a = args[i];
-      if (a == "-h" || a == "--help") {
+    for (ArgReader r(argc, argv); r.more();) {
+      if (r.help()) {
         std::cout << "usage: point_scaling [options]\n"
                      "  --scene NAME          world type (default urban; see scene_benchmark)\n"
                      "  --points N,N,...      target points per sweep (default\n"
@@ -63,32 +63,23 @@ int main(int argc, char** argv) {
                   << algorithmOptionsHelp();
         return 0;
       }
-      if (parseAlgorithmOption(args, i, settings, filter)) continue;
-      if (i + 1 >= args.size()) throw std::invalid_argument(a + ": missing value or unknown option");
-      const std::string& v = args[i + 1];
-      if (a == "--scene") {
-        scene_name = v;
-      } else if (a == "--points") {
-        sizes.clear();
-        for (const std::string& s : splitList(v)) {
-          const double n = io::parseNumber(a, s);
-          if (!(n >= 1000 && n <= 5e6)) throw std::invalid_argument("--points: each in [1000, 5e6]");
-          sizes.push_back(std::size_t(n));
-        }
-      } else if (a == "--trials") {
-        trials = int(io::parseNumber(a, v));
-        if (trials < 1) throw std::invalid_argument("--trials must be >= 1");
-      } else if (a == "--scene-seed") {
-        seed = std::uint64_t(io::parseNumber(a, v));
-      } else if (a == "--require-success") {
-        require_success = int(io::parseNumber(a, v));
-      } else if (a == "--csv") {
-        csv_path = v;
-      } else {
-        throw std::invalid_argument("unknown option: " + a);
-      }
-      i += 2;
+      if (r.algorithm(settings, filter) || r.option("--scene", scene_name) ||
+          r.optionWith("--points",
+                       [&](const std::string& v) {
+                         sizes.clear();
+                         for (const std::string& s : splitList(v)) {
+                           const double n = io::parseNumber("--points", s);
+                           if (!(n >= 1000 && n <= 5e6))
+                             throw std::invalid_argument("--points: each in [1000, 5e6]");
+                           sizes.push_back(std::size_t(n));
+                         }
+                       }) ||
+          r.option("--trials", trials) || r.option("--scene-seed", seed) ||
+          r.option("--require-success", require_success) || r.option("--csv", csv_path))
+        continue;
+      r.unknown();
     }
+    if (trials < 1) throw std::invalid_argument("--trials must be >= 1");
     validate(settings);
     const sim::Scene scene = sim::Scene::generate(sim::sceneTypeFromString(scene_name), seed);
     // Sensors 1 m above the street's ground, 2 m and 8 deg of yaw apart.
@@ -108,12 +99,10 @@ int main(int argc, char** argv) {
                 scene_name.c_str(), static_cast<unsigned long long>(seed), trials);
     std::printf("%10s %10s %10s %12s %16s %9s\n", "target", "points", "used", "median ms",
                 "ms per 1k points", "success");
-    std::ofstream csv;
-    if (!csv_path.empty()) {
-      csv.open(csv_path);
-      if (!csv) throw std::runtime_error(csv_path + ": cannot write");
-      csv << "target,points,points_used,median_time_s,time_per_kpoint_s,successes,trials\n";
-    }
+    std::optional<CsvWriter> csv;
+    if (!csv_path.empty())
+      csv.emplace(csv_path,
+                  "target,points,points_used,median_time_s,time_per_kpoint_s,successes,trials");
     CubeRegistration reg(settings);
     int short_sizes = 0;
     for (std::size_t target : sizes) {
@@ -140,8 +129,8 @@ int main(int argc, char** argv) {
       std::fflush(stdout);
       short_sizes += ok < require_success;
       if (csv) {
-        csv << target << ',' << scan.size() << ',' << used << ',' << med << ',' << per_k << ','
-            << ok << ',' << trials << '\n';
+        *csv << target << scan.size() << used << med << per_k << ok << trials;
+        csv->endRow();
       }
     }
     if (short_sizes > 0) {

@@ -8,6 +8,7 @@
 #include "cube_scan_matcher/core/filters.h"
 #include "cube_scan_matcher/core/registration.h"
 #include "cube_scan_matcher/io/cloud_io.h"
+#include "arg_reader.h"
 #include "settings_cli.h"
 
 using namespace cube_scan_matcher;
@@ -24,29 +25,25 @@ void usage(std::ostream& os) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  std::vector<std::string> args(argv + 1, argv + argc);
   RegistrationSettings settings = RegistrationSettings{};
   RangeFilterSettings filter;
   Pose6 guess = Pose6::Zero();
   std::vector<std::string> files;
   try {
-    for (std::size_t i = 0; i < args.size();) {
-      if (args[i] == "-h" || args[i] == "--help") {
+    for (tools::ArgReader r(argc, argv); r.more();) {
+      if (r.help()) {
         usage(std::cout);
         return 0;
       }
-      if (tools::parseAlgorithmOption(args, i, settings, filter)) continue;
-      if (args[i] == "--guess") {
-        if (i + 6 >= args.size()) throw std::invalid_argument("--guess needs 6 numbers");
-        for (int k = 0; k < 6; ++k) {
-          const double v = io::parseNumber("--guess", args[i + 1 + k]);
-          guess[k] = k < 3 ? v : deg2rad(v);
-        }
-        i += 7;
+      if (r.algorithm(settings, filter) ||
+          r.optionWith("--guess", 6, [&](const std::vector<std::string>& v) {
+            for (int k = 0; k < 6; ++k) {
+              const double x = io::parseNumber("--guess", v[std::size_t(k)]);
+              guess[k] = k < 3 ? x : deg2rad(x);
+            }
+          }))
         continue;
-      }
-      if (args[i].rfind("--", 0) == 0) throw std::invalid_argument("unknown option " + args[i]);
-      files.push_back(args[i++]);
+      files.push_back(r.positional());
     }
     if (files.size() != 2) {
       usage(std::cerr);

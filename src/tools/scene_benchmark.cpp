@@ -9,7 +9,6 @@
 //   scene_benchmark --worlds 20 --trials 10 --csv scenes.csv
 #include <algorithm>
 #include <cstdio>
-#include <fstream>
 #include <iostream>
 #include <map>
 #include <random>
@@ -23,6 +22,8 @@
 #include "cube_scan_matcher/core/registration.h"
 #include "cube_scan_matcher/sim/motion.h"
 #include "cube_scan_matcher/sim/tilting_scanner.h"
+#include "arg_reader.h"
+#include "csv_writer.h"
 #include "settings_cli.h"
 
 using namespace cube_scan_matcher;
@@ -123,7 +124,6 @@ double median(const std::vector<double>& v) { return quantile(v, 0.5); }
 }  // namespace
 
 int main(int argc, char** argv) {
-  std::vector<std::string> args(argv + 1, argv + argc);
   std::vector<std::string> scenes = {"hall", "urban", "park", "natural"};
   std::vector<std::string> motions = {"table1", "random"};
   std::vector<Bounds> bounds = {{"big", 1.0, 8.0}, {"small", 0.25, 2.0}};
@@ -138,42 +138,30 @@ int main(int argc, char** argv) {
   RegistrationSettings settings;
   RangeFilterSettings filter;
   try {
-    for (std::size_t i = 0; i < args.size();) {
-      const std::string& a = args[i];
-      if (a == "-h" || a == "--help") return usage(std::cout), 0;
-      if (parseAlgorithmOption(args, i, settings, filter)) continue;
-      if (a == "--artefacts") {
-        artefacts = true;
-        ++i;
+    auto bounds_of = [&](const std::string& v) {
+      if (v == "big") bounds = {{"big", 1.0, 8.0}};
+      else if (v == "small") bounds = {{"small", 0.25, 2.0}};
+      else if (v == "both") bounds = {{"big", 1.0, 8.0}, {"small", 0.25, 2.0}};
+      else throw std::invalid_argument("--initial-errors: expected big, small or both");
+    };
+    for (ArgReader r(argc, argv); r.more();) {
+      if (r.help()) return usage(std::cout), 0;
+      if (r.algorithm(settings, filter) || r.flag("--artefacts", artefacts) ||
+          r.optionWith("--scenes",
+                       [&](const std::string& v) { scenes = sim::expandSceneNames(splitList(v)); }) ||
+          r.option("--sweep-interval", sweep_interval) || r.option("--worlds", worlds) ||
+          r.option("--first-world", first_world) || r.option("--trials", trials) ||
+          r.optionWith("--motions", [&](const std::string& v) { motions = splitList(v); }) ||
+          r.optionWith("--initial-errors", bounds_of) || r.option("--trial-seed", seed) ||
+          r.option("--csv", csv_path) || r.option("--check-success", check_success) ||
+          r.option("--check-false-accepts", check_false_accepts) ||
+          r.option("--check-accepted", check_accepted) || r.option("--repeat", repeat) ||
+          r.optionWith("--check-repeatability", 2, [&](const std::vector<std::string>& v) {
+            check_rep_m = io::parseNumber("--check-repeatability", v[0]);
+            check_rep_deg = io::parseNumber("--check-repeatability", v[1]);
+          }))
         continue;
-      }
-      if (i + 1 >= args.size()) throw std::invalid_argument(a + ": missing value or unknown option");
-      const std::string v = args[i + 1];
-      if (a == "--scenes") scenes = sim::expandSceneNames(splitList(v));
-      else if (a == "--sweep-interval") sweep_interval = io::parseNumber(a, v);
-      else if (a == "--worlds") worlds = int(io::parseNumber(a, v));
-      else if (a == "--first-world") first_world = int(io::parseNumber(a, v));
-      else if (a == "--trials") trials = int(io::parseNumber(a, v));
-      else if (a == "--motions") motions = splitList(v);
-      else if (a == "--initial-errors") {
-        if (v == "big") bounds = {{"big", 1.0, 8.0}};
-        else if (v == "small") bounds = {{"small", 0.25, 2.0}};
-        else if (v == "both") bounds = {{"big", 1.0, 8.0}, {"small", 0.25, 2.0}};
-        else throw std::invalid_argument("--initial-errors: expected big, small or both");
-      } else if (a == "--trial-seed") seed = std::uint64_t(io::parseNumber(a, v));
-      else if (a == "--csv") csv_path = v;
-      else if (a == "--check-success") check_success = io::parseNumber(a, v);
-      else if (a == "--check-false-accepts") check_false_accepts = io::parseNumber(a, v);
-      else if (a == "--check-accepted") check_accepted = io::parseNumber(a, v);
-      else if (a == "--repeat") repeat = int(io::parseNumber(a, v));
-      else if (a == "--check-repeatability") {
-        if (i + 2 >= args.size()) throw std::invalid_argument(a + ": expects M D");
-        check_rep_m = io::parseNumber(a, v);
-        check_rep_deg = io::parseNumber(a, args[i + 2]);
-        ++i;
-      }
-      else throw std::invalid_argument("unknown option or value: " + a + " " + v);
-      i += 2;
+      r.unknown();
     }
     if (!(sweep_interval >= 0.0)) throw std::invalid_argument("--sweep-interval must be >= 0");
     if (worlds < 1 || trials < 1 || first_world < 1) {
@@ -188,13 +176,12 @@ int main(int argc, char** argv) {
     validate(settings);
     validate(filter);
 
-    std::ofstream csv(csv_path);
-    if (!csv) throw std::runtime_error(csv_path + ": cannot write");
-    csv << "scene,world,trial,motion,bounds,Es_m,Ea_deg,time_s,J,J_guess,J_truth,gate,success,"
-           "ex_m,ey_m,ez_m,erx_rad,ery_rad,erz_rad,sx_m,sy_m,sz_m,srx_rad,sry_rad,srz_rad,"
-           "degenerate,weak_ratio,polished,plane_rms_m,plane_fraction,"
-           "starts_agreeing,J_runner_up,J_coarse,t_weak_ratio,attempts,J_axis,axis_moved,consensus,"
-           "J_prepolish,polish_shift_m,polish_shift_deg\n";
+    CsvWriter csv(csv_path,
+                  "scene,world,trial,motion,bounds,Es_m,Ea_deg,time_s,J,J_guess,J_truth,gate,"
+                  "success,ex_m,ey_m,ez_m,erx_rad,ery_rad,erz_rad,sx_m,sy_m,sz_m,srx_rad,sry_rad,"
+                  "srz_rad,degenerate,weak_ratio,polished,plane_rms_m,plane_fraction,"
+                  "starts_agreeing,J_runner_up,J_coarse,t_weak_ratio,attempts,J_axis,axis_moved,"
+                  "consensus,J_prepolish,polish_shift_m,polish_shift_deg");
     CubeRegistration reg(settings);
     const GateSettings gate_settings;
     const sim::ScannerModel model = artefacts ? sim::scannerWithArtefacts() : sim::ScannerModel{};
@@ -249,18 +236,16 @@ int main(int argc, char** argv) {
               row.shift_deg = rad2deg(r.polish_shift_rad);
               row.plane_fraction =
                   r.polish_points ? double(r.plane_correspondences) / r.polish_points : 0.0;
-              csv << row.scene << ',' << w << ',' << t << ',' << row.motion << ',' << row.bounds
-                  << ',' << row.es << ',' << row.ea << ',' << row.time << ',' << row.J << ','
-                  << row.J_guess << ',' << row.J_truth << ',' << toString(row.reason) << ','
+              csv << row.scene << w << t << row.motion << row.bounds << row.es << row.ea
+                  << row.time << row.J << row.J_guess << row.J_truth << toString(row.reason)
                   << int(row.success());
-              for (int k = 0; k < 6; ++k) csv << ',' << row.error(k);
-              for (int k = 0; k < 6; ++k) csv << ',' << row.sigma(k);
-              csv << ',' << int(row.degenerate) << ',' << row.weak_ratio << ',' << int(row.polished)
-                  << ',' << row.plane_rms << ',' << row.plane_fraction << ',' << row.agreeing << ','
-                  << row.J_runner_up << ',' << row.J_coarse << ',' << row.t_weak_ratio << ','
-                  << row.attempts << ',' << row.J_axis << ',' << int(row.axis_moved) << ','
-                  << int(row.consensus) << ',' << row.J_prepolish << ',' << row.shift_m << ','
-                  << row.shift_deg << '\n';
+              for (int k = 0; k < 6; ++k) csv << row.error(k);
+              for (int k = 0; k < 6; ++k) csv << row.sigma(k);
+              csv << int(row.degenerate) << row.weak_ratio << int(row.polished) << row.plane_rms
+                  << row.plane_fraction << row.agreeing << row.J_runner_up << row.J_coarse
+                  << row.t_weak_ratio << row.attempts << row.J_axis << int(row.axis_moved)
+                  << int(row.consensus) << row.J_prepolish << row.shift_m << row.shift_deg;
+              csv.endRow();
               rows.push_back(row);
               if (repeat > 1) {
                 std::vector<Eigen::Isometry3d> estimates{r.transform};

@@ -6,12 +6,11 @@
 // drift while standing still, accepted / rejected scans, median time per scan.
 #include <chrono>
 #include <cstdio>
-#include <fstream>
 #include <functional>
 #include <iostream>
 #include <memory>
+#include <optional>
 #include <random>
-#include <sstream>
 #include <string>
 #include <vector>
 
@@ -24,6 +23,8 @@
 #include "cube_scan_matcher/sim/tilting_scanner.h"
 #include "open3d_peers.h"
 #include "peer_methods.h"
+#include "arg_reader.h"
+#include "csv_writer.h"
 #include "settings_cli.h"
 
 using namespace cube_scan_matcher;
@@ -173,7 +174,6 @@ Method peerMethod(const std::string& name, PeerFn fn, double voxel, bool constan
 }  // namespace
 
 int main(int argc, char** argv) {
-  std::vector<std::string> args(argv + 1, argv + argc);
   std::string scene_name, dir, odometry_mode = "big", csv_path = "sequence.csv", summary_path, label;
   double length = 500.0, period = 1.5, voxel = 0.2;
   sim::SequenceSettings motion;
@@ -184,37 +184,32 @@ int main(int argc, char** argv) {
   OnlineMatcherSettings matcher_settings;
   RangeFilterSettings filter;
   try {
-    for (std::size_t i = 0; i < args.size();) {
-      const std::string& a = args[i];
-      if (a == "-h" || a == "--help") return usage(std::cout), 0;
-      if (parseAlgorithmOption(args, i, matcher_settings.registration, filter)) continue;
-      if (i + 1 >= args.size()) throw std::invalid_argument(a + ": missing value or unknown option");
-      const std::string v = args[i + 1];
-      if (a == "--scene") scene_name = v;
-      else if (a == "--dir") dir = v;
-      else if (a == "--length") length = io::parseNumber(a, v);
-      else if (a == "--world-seed") seed = std::uint64_t(io::parseNumber(a, v));
-      else if (a == "--odometry") odometry_mode = v;
-      else if (a == "--period") period = io::parseNumber(a, v);
-      else if (a == "--step") motion.step = io::parseNumber(a, v);
-      else if (a == "--methods") methods = splitList(v);
-      else if (a == "--submap") submap = int(io::parseNumber(a, v));
-      else if (a == "--keyframe-distance") matcher_settings.keyframes.distance = io::parseNumber(a, v);
-      else if (a == "--keyframe-angle") matcher_settings.keyframes.angle = deg2rad(io::parseNumber(a, v));
-      else if (a == "--voxel") voxel = io::parseNumber(a, v);
-      else if (a == "--no-motion-candidate") matcher_settings.no_motion_candidate = io::parseNumber(a, v) != 0.0;
-      else if (a == "--reject-degenerate") matcher_settings.gate.reject_degenerate = io::parseNumber(a, v) != 0.0;
-      else if (a == "--require-polish") matcher_settings.gate.require_polish = io::parseNumber(a, v) != 0.0;
-      else if (a == "--max-sigma") matcher_settings.gate.max_sigma_m = io::parseNumber(a, v);
-      else if (a == "--csv") csv_path = v;
-      else if (a == "--summary") summary_path = v;
-      else if (a == "--label") label = v;
-      else if (a == "--check-pct") check_pct = io::parseNumber(a, v);
-      else if (a == "--check-deg-m") check_deg_m = io::parseNumber(a, v);
-      else if (a == "--check-still-m") check_still_m = io::parseNumber(a, v);
-      else if (a == "--check-rejected") check_rejected = io::parseNumber(a, v);
-      else throw std::invalid_argument("unknown option or value: " + a + " " + v);
-      i += 2;
+    auto& gate = matcher_settings.gate;
+    for (ArgReader r(argc, argv); r.more();) {
+      if (r.help()) return usage(std::cout), 0;
+      if (r.algorithm(matcher_settings.registration, filter) || r.option("--scene", scene_name) ||
+          r.option("--dir", dir) || r.option("--length", length) ||
+          r.option("--world-seed", seed) || r.option("--odometry", odometry_mode) ||
+          r.option("--period", period) || r.option("--step", motion.step) ||
+          r.optionWith("--methods", [&](const std::string& v) { methods = splitList(v); }) ||
+          r.option("--submap", submap) ||
+          r.option("--keyframe-distance", matcher_settings.keyframes.distance) ||
+          r.optionWith("--keyframe-angle",
+                       [&](const std::string& v) {
+                         matcher_settings.keyframes.angle =
+                             deg2rad(io::parseNumber("--keyframe-angle", v));
+                       }) ||
+          r.option("--voxel", voxel) ||
+          r.option("--no-motion-candidate", matcher_settings.no_motion_candidate) ||
+          r.option("--reject-degenerate", gate.reject_degenerate) ||
+          r.option("--require-polish", gate.require_polish) ||
+          r.option("--max-sigma", gate.max_sigma_m) || r.option("--csv", csv_path) ||
+          r.option("--summary", summary_path) || r.option("--label", label) ||
+          r.option("--check-pct", check_pct) || r.option("--check-deg-m", check_deg_m) ||
+          r.option("--check-still-m", check_still_m) ||
+          r.option("--check-rejected", check_rejected))
+        continue;
+      r.unknown();
     }
     if (scene_name.empty() == dir.empty()) throw std::invalid_argument("give one of --scene or --dir");
     if (!(length > 0.0) || !(period > 0.0) || !(voxel > 0.0) || !(motion.step > 0.0)) {
@@ -295,27 +290,24 @@ int main(int argc, char** argv) {
       if (k % 25 == 0) std::fprintf(stderr, "scan %zu, %.0f m\n", k, travelled);
     }
 
-    std::ofstream csv(csv_path);
-    if (!csv) throw std::runtime_error(csv_path + ": cannot write");
-    csv << "label,odometry,method,scan,time_s,truth_x,truth_y,truth_z,truth_yaw_deg,x,y,z,yaw_deg\n";
+    CsvWriter csv(csv_path,
+                  "label,odometry,method,scan,time_s,truth_x,truth_y,truth_z,truth_yaw_deg,x,y,z,"
+                  "yaw_deg");
     for (const Method& m : table) {
       for (std::size_t k = 0; k < truth.size(); ++k) {
         const Eigen::Vector3d t = truth[k].translation(), e = m.poses[k].translation();
-        csv << label << ',' << odometry_mode << ',' << m.name << ',' << k << ',' << m.times[k] << ','
-            << t.x() << ',' << t.y() << ',' << t.z() << ',' << yawDeg(truth[k]) << ',' << e.x()
-            << ',' << e.y() << ',' << e.z() << ',' << yawDeg(m.poses[k]) << '\n';
+        csv << label << odometry_mode << m.name << k << m.times[k] << t.x() << t.y() << t.z()
+            << yawDeg(truth[k]) << e.x() << e.y() << e.z() << yawDeg(m.poses[k]);
+        csv.endRow();
       }
     }
-    std::ofstream summary;
+    std::optional<CsvWriter> summary;
     if (!summary_path.empty()) {
-      const bool fresh = !std::ifstream(summary_path).good();
-      summary.open(summary_path, std::ios::app);
-      if (!summary) throw std::runtime_error(summary_path + ": cannot write");
-      if (fresh) {
-        summary << "label,odometry,method,scans,length_m,accepted,rejected,rpe10_pct,rpe10_deg_m,"
-                   "rpe50_pct,rpe50_deg_m,rpe100_pct,rpe100_deg_m,ate_m,still_scans,still_m,"
-                   "still_deg,median_time_s\n";
-      }
+      summary.emplace(summary_path,
+                      "label,odometry,method,scans,length_m,accepted,rejected,rpe10_pct,"
+                      "rpe10_deg_m,rpe50_pct,rpe50_deg_m,rpe100_pct,rpe100_deg_m,ate_m,"
+                      "still_scans,still_m,still_deg,median_time_s",
+                      CsvWriter::Mode::Append);
     }
     const StationaryDrift still_truth = stationaryDrift(truth, truth);
     std::printf("%s\n", machineReport().c_str());
@@ -342,15 +334,15 @@ int main(int argc, char** argv) {
       std::printf("%-14s %6d %6d %14s %14s %14s %8.3f %8.3f|%.2f %9.3f\n", m.name.c_str(),
                   m.accepted, m.rejected, cell(r[0]).c_str(), cell(r[1]).c_str(), cell(r[2]).c_str(),
                   ate, sd.translation, sd.rotation_deg, t_med);
-      if (summary.is_open()) {
-        summary << label << ',' << odometry_mode << ',' << m.name << ',' << truth.size() << ','
-                << travelled << ',' << m.accepted << ',' << m.rejected;
+      if (summary) {
+        *summary << label << odometry_mode << m.name << truth.size() << travelled << m.accepted
+                 << m.rejected;
         for (const RelativeError& e : r) {
-          if (e.segments == 0) summary << ",,";
-          else summary << ',' << e.translation_pct << ',' << e.rotation_deg_per_m;
+          if (e.segments == 0) *summary << "" << "";
+          else *summary << e.translation_pct << e.rotation_deg_per_m;
         }
-        summary << ',' << ate << ',' << sd.scans << ',' << sd.translation << ',' << sd.rotation_deg
-                << ',' << t_med << '\n';
+        *summary << ate << sd.scans << sd.translation << sd.rotation_deg << t_med;
+        summary->endRow();
       }
       if (m.name.rfind("cubes", 0) == 0) {
         const RelativeError* longest = nullptr;

@@ -13,12 +13,12 @@
 #include "cube_scan_matcher/core/registration.h"
 #include "cube_scan_matcher/sim/motion.h"
 #include "cube_scan_matcher/sim/tilting_scanner.h"
+#include "arg_reader.h"
 #include "settings_cli.h"
 
 using namespace cube_scan_matcher;
 
 int main(int argc, char** argv) {
-  std::vector<std::string> args(argv + 1, argv + argc);
   std::string scene_name = "urban";
   int sweeps = 6;
   std::string odometry_error = "small";
@@ -26,9 +26,8 @@ int main(int argc, char** argv) {
   RegistrationSettings settings = RegistrationSettings{};
   RangeFilterSettings filter;
   try {
-    for (std::size_t i = 0; i < args.size();) {
-      const std::string& a = args[i];
-      if (a == "-h" || a == "--help") {
+    for (tools::ArgReader r(argc, argv); r.more();) {
+      if (r.help()) {
         std::cout << "usage: simulate_and_register [options]\n"
                      "  --scene NAME          hall, urban, park, natural, square, slope, forest, tunnel,\n"
                      "                        wall or crowd (default urban; the crowd stands still)\n"
@@ -40,15 +39,11 @@ int main(int argc, char** argv) {
                   << tools::algorithmOptionsHelp();
         return 0;
       }
-      if (tools::parseAlgorithmOption(args, i, settings, filter)) continue;
-      if (i + 1 >= args.size()) throw std::invalid_argument(a + ": missing value or unknown option");
-      const std::string v = args[i + 1];
-      if (a == "--scene") scene_name = v;
-      else if (a == "--sweeps") sweeps = int(io::parseNumber(a, v));
-      else if (a == "--scene-seed") seed = std::uint64_t(io::parseNumber(a, v));
-      else if (a == "--odometry-error") odometry_error = v;
-      else throw std::invalid_argument("unknown option or value: " + a + " " + v);
-      i += 2;
+      if (r.algorithm(settings, filter) || r.option("--scene", scene_name) ||
+          r.option("--sweeps", sweeps) || r.option("--scene-seed", seed) ||
+          r.option("--odometry-error", odometry_error))
+        continue;
+      r.unknown();
     }
     if (sweeps < 2) throw std::invalid_argument("--sweeps must be >= 2");
     const sim::Scene scene = sim::Scene::generate(sim::sceneTypeFromString(scene_name), seed);

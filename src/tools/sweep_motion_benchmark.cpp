@@ -22,7 +22,6 @@
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
-#include <fstream>
 #include <iostream>
 #include <map>
 #include <optional>
@@ -35,6 +34,8 @@
 #include "cube_scan_matcher/core/online_matcher.h"
 #include "cube_scan_matcher/sim/motion.h"
 #include "cube_scan_matcher/sim/tilting_scanner.h"
+#include "arg_reader.h"
+#include "csv_writer.h"
 #include "settings_cli.h"
 
 using namespace cube_scan_matcher;
@@ -132,7 +133,6 @@ double median(const std::vector<double>& v) { return quantile(v, 0.5); }
 }  // namespace
 
 int main(int argc, char** argv) {
-  std::vector<std::string> args(argv + 1, argv + argc);
   std::vector<std::string> scenes = sim::expandSceneNames({"paper"});
   std::vector<Motion> motions = {{0.5, 10.0}, {1.0, 20.0}, {2.0, 30.0}};
   std::vector<double> durations = {1.0, 2.0, 4.0};
@@ -146,45 +146,46 @@ int main(int argc, char** argv) {
   OnlineMatcherSettings settings;
   RangeFilterSettings filter;
   try {
-    for (std::size_t i = 0; i < args.size();) {
-      const std::string& a = args[i];
-      if (a == "-h" || a == "--help") return usage(std::cout), 0;
-      if (parseAlgorithmOption(args, i, settings.registration, filter)) continue;
-      if (i + 1 >= args.size()) throw std::invalid_argument(a + ": missing value or unknown option");
-      const std::string v = args[i + 1];
-      if (a == "--scenes") scenes = sim::expandSceneNames(splitList(v));
-      else if (a == "--worlds") worlds = int(io::parseNumber(a, v));
-      else if (a == "--sweeps") sweeps = int(io::parseNumber(a, v));
-      else if (a == "--motions") {
-        motions.clear();
-        for (const std::string& m : splitList(v)) {
-          const std::size_t colon = m.find(':');
-          if (colon == std::string::npos) throw std::invalid_argument("--motions: expected speed:yaw-rate, got " + m);
-          motions.push_back({io::parseNumber(a, m.substr(0, colon)), io::parseNumber(a, m.substr(colon + 1))});
-        }
-      } else if (a == "--durations") {
-        durations.clear();
-        for (const std::string& d : splitList(v)) durations.push_back(io::parseNumber(a, d));
-      } else if (a == "--odometry") odometry_models = splitList(v);
-      else if (a == "--modes") modes = splitList(v);
-      else if (a == "--start") {
-        if (v != "rest" && v != "moving") throw std::invalid_argument("--start: rest or moving");
-        from_rest = v == "rest";
-      } else if (a == "--trial-seed") seed = std::uint64_t(io::parseNumber(a, v));
-      else if (a == "--csv") csv_path = v;
-      else if (a == "--check") {
-        const std::vector<std::string> f = [&] {
-          std::vector<std::string> parts;
-          std::size_t from = 0, to;
-          while ((to = v.find(':', from)) != std::string::npos) parts.push_back(v.substr(from, to - from)), from = to + 1;
-          parts.push_back(v.substr(from));
-          return parts;
-        }();
-        if (f.size() != 5) throw std::invalid_argument("--check: expected MODE:V:W:ES:EA, got " + v);
-        checks.push_back({f[0], io::parseNumber(a, f[1]), io::parseNumber(a, f[2]),
-                          io::parseNumber(a, f[3]), io::parseNumber(a, f[4])});
-      } else throw std::invalid_argument("unknown option or value: " + a + " " + v);
-      i += 2;
+    auto motions_of = [&](const std::string& v) {
+      motions.clear();
+      for (const std::string& m : splitList(v)) {
+        const std::size_t colon = m.find(':');
+        if (colon == std::string::npos)
+          throw std::invalid_argument("--motions: expected speed:yaw-rate, got " + m);
+        motions.push_back({io::parseNumber("--motions", m.substr(0, colon)),
+                           io::parseNumber("--motions", m.substr(colon + 1))});
+      }
+    };
+    auto durations_of = [&](const std::string& v) {
+      durations.clear();
+      for (const std::string& d : splitList(v)) durations.push_back(io::parseNumber("--durations", d));
+    };
+    auto start_of = [&](const std::string& v) {
+      if (v != "rest" && v != "moving") throw std::invalid_argument("--start: rest or moving");
+      from_rest = v == "rest";
+    };
+    auto check_of = [&](const std::string& v) {
+      std::vector<std::string> f;
+      std::size_t from = 0, to;
+      while ((to = v.find(':', from)) != std::string::npos) f.push_back(v.substr(from, to - from)), from = to + 1;
+      f.push_back(v.substr(from));
+      if (f.size() != 5) throw std::invalid_argument("--check: expected MODE:V:W:ES:EA, got " + v);
+      checks.push_back({f[0], io::parseNumber("--check", f[1]), io::parseNumber("--check", f[2]),
+                        io::parseNumber("--check", f[3]), io::parseNumber("--check", f[4])});
+    };
+    for (ArgReader r(argc, argv); r.more();) {
+      if (r.help()) return usage(std::cout), 0;
+      if (r.algorithm(settings.registration, filter) ||
+          r.optionWith("--scenes",
+                       [&](const std::string& v) { scenes = sim::expandSceneNames(splitList(v)); }) ||
+          r.option("--worlds", worlds) || r.option("--sweeps", sweeps) ||
+          r.optionWith("--motions", motions_of) || r.optionWith("--durations", durations_of) ||
+          r.optionWith("--odometry", [&](const std::string& v) { odometry_models = splitList(v); }) ||
+          r.optionWith("--modes", [&](const std::string& v) { modes = splitList(v); }) ||
+          r.optionWith("--start", start_of) || r.option("--trial-seed", seed) ||
+          r.option("--csv", csv_path) || r.optionWith("--check", check_of))
+        continue;
+      r.unknown();
     }
     if (worlds < 1) throw std::invalid_argument("--worlds must be >= 1");
     if (sweeps < 3) throw std::invalid_argument("--sweeps must be >= 3");
@@ -209,10 +210,9 @@ int main(int argc, char** argv) {
     validate(settings);
     validate(filter);
 
-    std::ofstream csv(csv_path);
-    if (!csv) throw std::runtime_error(csv_path + ": cannot write");
-    csv << "scene,world,trial,speed_mps,yaw_rate_dps,duration_s,odometry,mode,k,accepted,success,"
-           "Es_m,Ea_deg,time_s\n";
+    CsvWriter csv(csv_path,
+                  "scene,world,trial,speed_mps,yaw_rate_dps,duration_s,odometry,mode,k,accepted,"
+                  "success,Es_m,Ea_deg,time_s");
     const sim::ScannerModel model;
     std::vector<Row> rows;
     int trial = 0;
@@ -264,10 +264,10 @@ int main(int argc, char** argv) {
                                                 run.truth[k - 1].inverse() * run.truth[k]);
                   Row row{scene_name, odometry_models[o], mode, motion, duration, w, trial, k,
                           step.accepted, e.es_m, e.ea_deg, seconds};
-                  csv << row.scene << ',' << w << ',' << trial << ',' << motion.speed << ','
-                      << motion.yaw_rate_deg << ',' << duration << ',' << row.odometry << ','
-                      << mode << ',' << k << ',' << int(row.accepted) << ',' << int(row.success())
-                      << ',' << row.es << ',' << row.ea << ',' << row.time << '\n';
+                  csv << row.scene << w << trial << motion.speed << motion.yaw_rate_deg
+                      << duration << row.odometry << mode << k << int(row.accepted)
+                      << int(row.success()) << row.es << row.ea << row.time;
+                  csv.endRow();
                   rows.push_back(row);
                 }
               }
