@@ -291,6 +291,10 @@ struct Iterated {
   Eigen::Matrix3d R;
   Eigen::Vector3d t;
   int iterations = 0;
+  /// The radius of gyration about the scan's origin of the points near a plane at the start
+  /// (far outliers have none): the lever arm that makes a rotation comparable with a
+  /// translation. 1 m when no step was taken.
+  double rho = 1.0;
 };
 
 /// The Gauss-Newton rounds from (R, t). Each round starts with a pass over every scan point
@@ -299,13 +303,14 @@ struct Iterated {
 /// collected where the pose no longer is); the polish ends after a converged round that
 /// started at a converged pose, so the final set is collected at the result and does not
 /// depend on the start. Correspondences are trilinear (lineariseTrilinear), so the objective is
-/// continuous in the pose. `rho` gets the lever arm of the first round's points.
+/// continuous in the pose.
 Iterated iterate(const PlaneMap& map, const PointArray& scan, const Eigen::Isometry3d& start,
-                 const PolishSettings& s, PointArray& near, double& rho) {
-  Iterated res{start.linear(), start.translation(), 0};
+                 const PolishSettings& s, PointArray& near) {
+  Iterated res{start.linear(), start.translation()};
   Eigen::Matrix3d& R = res.R;
   Eigen::Vector3d& t = res.t;
   int& it = res.iterations;
+  double& rho = res.rho;
   // Reused from call to call: fresh corner lists of a few thousand entries would be faulted in
   // page by page at every registration (~10 us per page fault on a VM). The first round's
   // corners stay valid as a cache for the second round's collecting pass (the pose has moved
@@ -428,11 +433,8 @@ PolishResult polishOnPlanes(const PlaneMap& map, const PointArray& scan, const P
     return res;
   }
   const Eigen::Isometry3d T0 = poseToIsometry(pose);
-  // The radius of gyration about the scan's origin of the points near a plane at the start (far
-  // outliers have none): the lever arm that makes a rotation comparable with a translation.
-  double rho = 1.0;
   thread_local PointArray near;  // reused: see iterate()
-  const Iterated end = iterate(map, scan, T0, s, near, rho);
+  const Iterated end = iterate(map, scan, T0, s, near);
   res.iterations = end.iterations;
 
   // The covariance and the weak axes from each point's own voxel's plane (with the trilinear
@@ -459,7 +461,7 @@ PolishResult polishOnPlanes(const PlaneMap& map, const PointArray& scan, const P
   res.pose = isometryToPose(T);
   res.applied = true;
   res.rms = std::sqrt(L.weighted_r2 / L.weight);
-  setCovariance(L, rows, rho, s, res);
+  setCovariance(L, rows, end.rho, s, res);
   checkTranslation(L, rows, s, res);
   return res;
 }

@@ -57,9 +57,6 @@ class CsvWriter {
     cells_ = 0;
   }
 
-  /// Writes what is buffered; false when the file could not be written.
-  bool flush() { return bool(out_.flush()); }
-
  private:
   std::string path_;
   std::ofstream out_;

@@ -274,9 +274,9 @@ TEST(PlanePolish, ACorridorIsFlaggedAlongItsAxisAndNotMovedAlongIt) {
 }
 
 // Over-relaxation stretches steps that keep their direction: from a start 12 cm / 0.5 deg off it
-// must land on the plain iteration's pose (the same fixed point). With trilinear
-// correspondences the plain steps no longer fall short on this pair (5 steps either way, 5
-// against 6 from 16 cm off): the steps are printed, not compared.
+// must land on the plain iteration's pose (the same fixed point). On this pair the trilinear
+// objective's plain steps do not fall short (5 steps either way; 5 against 6 from 16 cm off),
+// so the step counts are printed, not compared.
 TEST(PlanePolish, OverRelaxationReachesThePlainPose) {
   const KnownPair known(false);
   PolishSettings plain;
@@ -330,8 +330,8 @@ TEST(PlanePolish, CollectingThePointsAgainKeepsTheFixedPoint) {
 }
 
 // Trilinear correspondences make the objective continuous in the pose: polishes started up to
-// 3 cm / 0.3 deg apart must end on one pose (with one plane per point, each point's own voxel,
-// they ended 2-6 mm apart, where the steps of the piecewise objective left them).
+// 3 cm / 0.3 deg apart must end on one pose (one plane per point, each point's own voxel, gives
+// a piecewise objective whose steps stop 2-6 mm apart: docs/experiments.md).
 TEST(PlanePolish, TrilinearCorrespondencesEndOnOnePoseFromEveryStart) {
   const KnownPair known(false);
   std::mt19937_64 rng(7);

@@ -7,10 +7,10 @@
 #include <atomic>
 #include <cmath>
 #include <cstdint>
+#include <cstdlib>
 #include <cstring>
 #include <limits>
 #include <new>
-#include <cstdlib>
 #include <string>
 #include <vector>
 
@@ -167,7 +167,7 @@ TEST(CloudIo, NonFinitePointsAreKeptWhenSomeAreFinite) {
   EXPECT_EQ(p.z[1], 3.f);
 }
 
-TEST(CloudIo, LiesAreRefusedQuicklyWithTheirReason) {
+TEST(CloudIo, LiesAreRefusedWithTheirReason) {
   std::string body;
   for (int i = 0; i < 300; ++i) append(body, float(i));  // 100 points
   largest_allocation = 0;
