@@ -184,12 +184,12 @@ bool takenOverTime(const PointTimes* times) {
 
 }  // namespace
 
-OnlineStep OnlineMatcher::process(const PointArray& scan_points, double stamp,
+OnlineStep OnlineMatcher::process(const PointArray& points, double stamp,
                                   const std::optional<Eigen::Isometry3d>& given_odom,
                                   const PointTimes* times) {
-  if (times && times->tau.size() != scan_points.size()) {
+  if (times && times->tau.size() != points.size()) {
     throw std::invalid_argument("process: " + std::to_string(times->tau.size()) +
-                                " point times for " + std::to_string(scan_points.size()) + " points");
+                                " point times for " + std::to_string(points.size()) + " points");
   }
   if (!std::isfinite(stamp)) throw std::invalid_argument("process: the scan's stamp is not finite");
   OnlineStep step;
@@ -201,21 +201,21 @@ OnlineStep OnlineMatcher::process(const PointArray& scan_points, double stamp,
   const Keyframe* keyframe = first ? nullptr : &keyframes_.back();
   std::optional<PointArray> deskewed;  // the scan re-placed with the registered motion
   if (first) {
-    step.reason = scan_points.empty() ? GateReason::BadInput : GateReason::FirstScan;
+    step.reason = points.empty() ? GateReason::BadInput : GateReason::FirstScan;
     step.pose = predicted.pose;
-  } else if (scan_points.empty()) {
+  } else if (points.empty()) {
     step.reason = GateReason::BadInput;
   } else {
-    registerAndGate(step, scan_points, stamp, predicted.from, *keyframe);
+    registerAndGate(step, points, stamp, predicted.from, *keyframe);
     if (step.accepted && takenOverTime(times) && settings_.deskew.enabled && last_known_ &&
         stamp > last_known_->stamp) {
-      deskewScan(step, scan_points, *times, stamp - last_known_->stamp, placed, *keyframe,
+      deskewScan(step, points, *times, stamp - last_known_->stamp, placed, *keyframe,
                  scaledGate(step.gate_scale), deskewed);
     }
   }
   const bool refused = !placeScan(step, keyframe, predicted.pose);
   countRejections(step, keyframe);
-  updateChain(step, deskewed ? *deskewed : scan_points, stamp, odom, keyframe, refused);
+  updateChain(step, deskewed ? *deskewed : points, stamp, odom, keyframe, refused);
   describe(step);
   return step;
 }

@@ -341,7 +341,7 @@ void CubeRegistration::searchAttempt(const ScanPoints& points, const Pose6& gues
   if (settings_.polish.enabled && res.J > 0 && reference_->planes.voxels() > 0) {
     const auto polish_start = Clock::now();
     // J on the E grid before the polish moves the pose (a diagnostic: how many coincident cubes
-    // the point-to-plane optimum costs; the scene benchmark's CSV, BENCHMARK.md).
+    // the point-to-plane optimum costs; a column of the scene benchmark's CSV).
     res.J_prepolish = resultObjective(points)(res.pose);
     ++res.evaluations;
     polishStage(points, res);

@@ -58,6 +58,9 @@ void usage(std::ostream& os) {
         "  --trial-seed N        seed of the initial-guess errors (default 1)\n"
         "  --csv FILE            per-trial rows with the estimate at full precision\n"
         "                        (default benchmark.csv)\n"
+        "  --check-repeatability M D  exit 3 unless every cube method's repeatability (the\n"
+        "                        median distance of the trials' estimates to their median\n"
+        "                        pose) is <= M [m] and D [deg] on every pair (default off)\n"
         "  --require-success K   exit 3 unless every cube method succeeds (Es < 0.10 m and\n"
         "                        Ea < 1 deg) in at least K trials of every pair (default off)\n"
         "Options of the 'cubes' method (cubes-paper ignores all but --edges/--seed/--max-cubes):\n"
@@ -103,6 +106,7 @@ int main(int argc, char** argv) {
   RangeFilterSettings filter;
   std::string dir, csv_path = "benchmark.csv";
   int trials = 25, require = -1;
+  double check_rep_m = -1, check_rep_deg = -1;  // --check-repeatability (-1: off)
   unsigned trial_seed = 1;
   double voxel = 0.2;
   std::vector<std::string> methods = kAllMethods;
@@ -142,7 +146,11 @@ int main(int argc, char** argv) {
           r.optionWith("--initial-errors", bounds_of) || r.optionWith("--methods", methods_of) ||
           r.optionWith("--edges", edges_of) || r.option("--voxel", voxel) ||
           r.option("--trial-seed", trial_seed) || r.option("--csv", csv_path) ||
-          r.option("--require-success", require))
+          r.option("--require-success", require) ||
+          r.optionWith("--check-repeatability", 2, [&](const std::vector<std::string>& v) {
+            check_rep_m = parseNumber("--check-repeatability", v[0]);
+            check_rep_deg = parseNumber("--check-repeatability", v[1]);
+          }))
         continue;
       if (!dir.empty()) throw std::invalid_argument("more than one DATASET_DIR given");
       dir = r.positional();
@@ -313,6 +321,13 @@ int main(int argc, char** argv) {
           if (is_cube && cube_time == 0.0) cube_time = mt;
           if (is_cube && require >= 0 && ok < require) require_ok = false;
           const Repeatability rep = repeatability(estimates);
+          if (is_cube && check_rep_m >= 0 &&
+              (rep.median_m > check_rep_m || rep.median_deg > check_rep_deg)) {
+            std::fprintf(stderr, "benchmark: %s %s: repeatability %.5f m / %.5f deg > %g m / %g "
+                         "deg\n", pair.name.c_str(), name.c_str(), rep.median_m, rep.median_deg,
+                         check_rep_m, check_rep_deg);
+            require_ok = false;
+          }
           std::printf("%-44s %-6s %-22s %9.4f %9.3f %10.4f %5d/%-2d %10.1f %7.4f|%7.4f\n",
                       pair.name.c_str(), b.name.c_str(), name.c_str(), median(es), median(ea), mt,
                       ok, int(es.size()), cube_time > 0 ? mt / cube_time : 0.0, rep.median_m,
@@ -324,8 +339,8 @@ int main(int argc, char** argv) {
                 "method's; rep: median over trials of the distance to the method's median pose "
                 "(repeatability); CSV: %s\n", csv_path.c_str());
     if (!require_ok) {
-      std::fprintf(stderr, "benchmark: a cube method succeeded in fewer than %d of %d trials\n",
-                   require, trials);
+      std::fprintf(stderr, "benchmark: a cube method missed --require-success %d of %d trials "
+                   "or --check-repeatability\n", require, trials);
       return 3;
     }
   } catch (const std::exception& e) {

@@ -1,6 +1,7 @@
 // objective_profile: J along the driving direction between two sweeps of the simulated tilting
 // scanner taken `--step` m apart, on all scan points and on the densely sampled ones
-// (dense_sampling.h). Shows J's false maximum at "no motion" (BENCHMARK.md).
+// (dense_sampling.h). Shows J's false maximum at "no motion" (docs/experiments.md, "The
+// no-motion maximum and dense_points").
 //   objective_profile --scene hall --seed 1 --step 1.5
 #include <cstdio>
 #include <iostream>

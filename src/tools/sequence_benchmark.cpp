@@ -350,6 +350,12 @@ int main(int argc, char** argv) {
           if (e.segments > 0) longest = &e;
         }
         char b[160];
+        if (!longest && (check_pct >= 0 || check_deg_m >= 0)) {
+          // A drift bound that nothing could be checked against fails rather than passes.
+          std::snprintf(b, sizeof b, "%s: no 10 m segment to check the drift bounds on",
+                        m.name.c_str());
+          failures.push_back(b);
+        }
         if (longest && check_pct >= 0 && longest->translation_pct > check_pct) {
           std::snprintf(b, sizeof b, "%s: %.2f %% over %.0f m > %.2f %%", m.name.c_str(),
                         longest->translation_pct, longest->length, check_pct);

@@ -17,7 +17,7 @@
 // increment of a run is reported apart. A run starts standing still (its first sweep taken from
 // one pose, odometry exact while standing) unless --start moving: a first sweep taken while
 // driving is bent by the odometry's error, no earlier scan can correct it, and de-skewing the
-// later sweeps against it carries its bend on (measured: BENCHMARK.md).
+// later sweeps against it carries its bend on (measured: BENCHMARK.md, "Sweeps taken while driving").
 //   sweep_motion_benchmark --worlds 3 --csv sweep_motion.csv
 #include <algorithm>
 #include <chrono>
@@ -61,6 +61,8 @@ void usage(std::ostream& os) {
         "  --check MODE:V:W:ES:EA  exit 2 unless MODE's median Es <= ES [m] and Ea <= EA [deg]\n"
         "                      over the steady increments of the runs at speed <= V [m/s] and\n"
         "                      yaw rate <= W [deg/s] (repeatable)\n"
+        "  --max-accepted-wrong MODE:N  exit 2 when more than N of MODE's increments (the\n"
+        "                      first ones included) were accepted without success\n"
      << algorithmOptionsHelp();
 }
 
@@ -139,6 +141,8 @@ int main(int argc, char** argv) {
   std::vector<std::string> odometry_models = {"big", "drift"};
   std::vector<std::string> modes = {"static", "rigid", "deskew0", "deskew"};
   std::vector<Check> checks;
+  std::string wrong_cap_mode;  // --max-accepted-wrong MODE:N (empty: no limit)
+  int wrong_cap = 0;
   int worlds = 3, sweeps = 5;
   bool from_rest = true;
   std::uint64_t seed = 1;
@@ -173,6 +177,15 @@ int main(int argc, char** argv) {
       checks.push_back({f[0], io::parseNumber("--check", f[1]), io::parseNumber("--check", f[2]),
                         io::parseNumber("--check", f[3]), io::parseNumber("--check", f[4])});
     };
+    auto wrong_cap_of = [&](const std::string& v) {
+      const std::size_t colon = v.find(':');
+      if (colon == std::string::npos) throw std::invalid_argument("--max-accepted-wrong: MODE:N");
+      wrong_cap_mode = v.substr(0, colon);
+      const double n = io::parseNumber("--max-accepted-wrong", v.substr(colon + 1));
+      if (!(n >= 0 && n == std::floor(n)))
+        throw std::invalid_argument("--max-accepted-wrong: N must be a whole number >= 0");
+      wrong_cap = int(n);
+    };
     for (ArgReader r(argc, argv); r.more();) {
       if (r.help()) return usage(std::cout), 0;
       if (r.algorithm(settings.registration, filter) ||
@@ -183,11 +196,15 @@ int main(int argc, char** argv) {
           r.optionWith("--odometry", [&](const std::string& v) { odometry_models = splitList(v); }) ||
           r.optionWith("--modes", [&](const std::string& v) { modes = splitList(v); }) ||
           r.optionWith("--start", start_of) || r.option("--trial-seed", seed) ||
-          r.option("--csv", csv_path) || r.optionWith("--check", check_of))
+          r.option("--csv", csv_path) || r.optionWith("--check", check_of) ||
+          r.optionWith("--max-accepted-wrong", wrong_cap_of))
         continue;
       r.unknown();
     }
     if (worlds < 1) throw std::invalid_argument("--worlds must be >= 1");
+    if (!wrong_cap_mode.empty() &&
+        std::find(modes.begin(), modes.end(), wrong_cap_mode) == modes.end())
+      throw std::invalid_argument("--max-accepted-wrong: mode " + wrong_cap_mode + " is not run");
     if (sweeps < 3) throw std::invalid_argument("--sweeps must be >= 3");
     for (const Motion& m : motions) {
       if (!(m.speed >= 0.0 && m.speed <= 5.0) || !(std::abs(m.yaw_rate_deg) <= 90.0))
@@ -329,6 +346,20 @@ int main(int argc, char** argv) {
       std::printf("check %s up to %.2g m/s and %.3g deg/s: median Es %.4f m (<= %.4f), Ea %.4f deg (<= %.4f)\n",
                   ch.mode.c_str(), ch.speed, ch.yaw_rate, median(es), ch.es, median(ea), ch.ea);
       if (median(es) > ch.es || median(ea) > ch.ea) failures.push_back("--check " + ch.mode + " missed");
+    }
+    std::map<std::string, std::pair<int, int>> wrong;  // mode: accepted wrong, increments
+    for (const Row& r : rows) {
+      wrong[r.mode].first += r.accepted && !r.success();
+      ++wrong[r.mode].second;
+    }
+    for (const auto& [mode, count] : wrong) {
+      std::printf("%s: %d of %d increments accepted without success\n", mode.c_str(),
+                  count.first, count.second);
+    }
+    if (!wrong_cap_mode.empty() && wrong[wrong_cap_mode].first > wrong_cap) {
+      failures.push_back("--max-accepted-wrong " + wrong_cap_mode + ": " +
+                         std::to_string(wrong[wrong_cap_mode].first) + " > " +
+                         std::to_string(wrong_cap));
     }
     for (const std::string& f : failures) std::fprintf(stderr, "CHECK FAILED %s\n", f.c_str());
     if (!failures.empty()) return 2;

@@ -1,6 +1,7 @@
 // The coarse stage: independent GNMM starts, ranked by J, each the GNMM run of its own seed.
 #include <gtest/gtest.h>
 
+#include <cstdio>
 #include <stdexcept>
 #include <vector>
 
@@ -43,8 +44,11 @@ TEST(CoarseSearch, RanksTheStartsByJAndEachIsTheGnmmRunOfItsSeed) {
   }
   EXPECT_EQ(r.evaluations, evaluations);
   EXPECT_EQ(r.iterations, iterations);
-  // From a 0.5 m / 6 deg error on a clean scene, the best start is within a cube of the truth.
-  EXPECT_LT((r.runs[0].best.head<3>() - truth.head<3>()).norm(), 0.5);
+  // From a 0.5 m / 6 deg error on a clean scene, the best start is within half a cube of the
+  // truth.
+  const double off = (r.runs[0].best.head<3>() - truth.head<3>()).norm();
+  std::printf("[ best     ] %.3f m from the truth\n", off);
+  EXPECT_LT(off, 0.25);
 }
 
 TEST(CoarseSearch, NeedsAnObjectivePerThreadAndValidSettings) {

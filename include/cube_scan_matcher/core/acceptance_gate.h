@@ -47,14 +47,16 @@ struct GateSettings {
   /// Reject a result marked ambiguous (RegistrationResult::ambiguous, SearchSettings::
   /// ambiguous_weak_ratio): weakly fixed along a translation axis, most starts found other
   /// maxima, and no retry landed on the same pose (robot worlds with the sensor's artefacts at
-  /// collapse 0.5: it takes the wrongly accepted results from 7 to 3, BENCHMARK.md).
+  /// collapse 0.5: it takes the wrongly accepted results from 7 to 3; docs/experiments.md,
+  /// "The axis probe, the consensus rule and the coarse collapse E/2").
   bool reject_ambiguous = true;
   /// Reject a polished result whose largest translation standard deviation (from its
   /// covariance, RegistrationResult::covariance, calibrated on the scene benchmark) exceeds
   /// this [m]; 0 = off. A sanity bound, not a separator: on the scene benchmark no wrong
   /// result has been rejected by it alone. With the clustered covariance (PolishSettings::
-  /// covariance_cell_m) right results in the robot worlds reach 3-7 cm (crowd, forest, wall):
-  /// 3 cm would reject 20 of their 2400, 5 cm rejects 6 (BENCHMARK.md). >= 0.
+  /// covariance_cell_m) and the jackknife, right results in the robot worlds reach about 9 cm:
+  /// 5 cm rejects 13 of their 2400 as uncertain, and 65 accepted right ones lie above 3 cm
+  /// (trial seed 2, docs/results/scenes/scenes_robot.csv). >= 0.
   double max_sigma_m = 0.05;
 };
 

@@ -58,7 +58,8 @@ struct PolishSettings {
   /// finds fewer than min_correspondences. 0.2 m (0.4 E): a
   /// polish that starts 0.2 m / 0.5 deg off after a poor refine walked 0.2497 m to a pose
   /// 11 cm off; right results move up to 0.24 m (robot worlds, p99 0.19 m), so this costs
-  /// 13 of 5 900 accepted right results in the robot worlds and artefacts (BENCHMARK.md).
+  /// 13 of 5 900 accepted right results in the robot worlds and artefacts (docs/experiments.md,
+  /// "A polish that must stay near the cube result").
   double max_shift_m = 0.2;
   double max_shift_rad = 0.03490658503988659;  // 2 deg
   int min_correspondences = 50;
@@ -77,7 +78,8 @@ struct PolishSettings {
   double degenerate_sigma_m = 1.0;
   /// The covariance: sigma^2 (H)^-1 from the weighted residuals, times this factor. The raw
   /// least-squares covariance is too small (neighbouring residuals share a reference plane's
-  /// error): on the scene benchmark (20 worlds of each type, seed 1, BENCHMARK.md) the 99th
+  /// error): on the scene benchmark (20 worlds of each type, seed 1; docs/experiments.md,
+  /// "A covariance from the residuals' clusters") the 99th
   /// percentile of |error| / sd per axis asked for factors of 1.6-12.5 (hall x the largest);
   /// 12 keeps every axis within 3 sd in ~99 % of the accepted results. In [1, 1e6].
   double covariance_scale = 12.0;

@@ -1,6 +1,9 @@
-// ScanMatcherNodelet: the ROS face of the package. A thin layer over core/online_matcher.h:
-// it reads clouds and tf, calls the core, and publishes pose, odometry, path, registered cloud,
-// status, optional tf and diagnostics. Topics and frames: README.md; parameters: docs/parameters.md.
+// ScanMatcherNodelet: the ROS face of the package, around core/online_matcher.h, which holds
+// the matching itself. The nodelet converts clouds (cloud_conversion.h), reads the odometry
+// and the sensor's mount from tf, calls the core, and publishes pose, odometry, path,
+// registered cloud, status, optional tf and diagnostics; it also owns the services, dynamic
+// reconfigure and the handling of stamps going backwards. Topics and frames: README.md;
+// parameters: docs/parameters.md.
 #pragma once
 
 #include <deque>
