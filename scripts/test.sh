@@ -35,7 +35,8 @@ if [ -n "$DATA_DIR" ]; then
   for d in "$DATA_DIR"/*/; do
     [ -f "$d/pairs.txt" ] || continue
     build/devel/lib/cube_scan_matcher/benchmark "$d" --methods cubes --trials 25 \
-      --require-success 25 --check-repeatability 0.0007 0.006 --csv "build/accuracy_$(basename "$d").csv" 2>/dev/null || status=1
+      --require-success 25 --check-repeatability 0.0007 0.006 \
+      --csv "build/accuracy_$(basename "$d").csv" 2>/dev/null || status=1
     bash scripts/replay_check.sh "$d" || status=1
     if [ -f "$d/poses.tum" ]; then
       build/devel/lib/cube_scan_matcher/sequence_benchmark --dir "$d" --methods cubes \

@@ -300,7 +300,7 @@ int main(int argc, char** argv) {
     std::printf("%s\n", machineReport().c_str());
     std::printf("\n%-44s %-6s %-22s %9s %9s %10s %8s %10s %16s\n", "pair", "bounds", "method",
                 "med Es[m]", "med Ea[°]", "med t[s]", "success", "t/t_cube", "rep [m]|[°]");
-    bool require_ok = true;
+    bool checks_ok = true;
     for (const auto& pair : pairs) {
       for (const Bounds& b : bounds) {
         double cube_time = 0.0;
@@ -319,14 +319,14 @@ int main(int argc, char** argv) {
           const double mt = median(tm);
           const bool is_cube = name.rfind("cubes", 0) == 0;
           if (is_cube && cube_time == 0.0) cube_time = mt;
-          if (is_cube && require >= 0 && ok < require) require_ok = false;
+          if (is_cube && require >= 0 && ok < require) checks_ok = false;
           const Repeatability rep = repeatability(estimates);
           if (is_cube && check_rep_m >= 0 &&
               (rep.median_m > check_rep_m || rep.median_deg > check_rep_deg)) {
             std::fprintf(stderr, "benchmark: %s %s: repeatability %.5f m / %.5f deg > %g m / %g "
                          "deg\n", pair.name.c_str(), name.c_str(), rep.median_m, rep.median_deg,
                          check_rep_m, check_rep_deg);
-            require_ok = false;
+            checks_ok = false;
           }
           std::printf("%-44s %-6s %-22s %9.4f %9.3f %10.4f %5d/%-2d %10.1f %7.4f|%7.4f\n",
                       pair.name.c_str(), b.name.c_str(), name.c_str(), median(es), median(ea), mt,
@@ -338,7 +338,7 @@ int main(int argc, char** argv) {
     std::printf("success: Es < 0.10 m and Ea < 1 deg; t/t_cube: median time over the first cube "
                 "method's; rep: median over trials of the distance to the method's median pose "
                 "(repeatability); CSV: %s\n", csv_path.c_str());
-    if (!require_ok) {
+    if (!checks_ok) {
       std::fprintf(stderr, "benchmark: a cube method missed --require-success %d of %d trials "
                    "or --check-repeatability\n", require, trials);
       return 3;

@@ -17,7 +17,8 @@
 // increment of a run is reported apart. A run starts standing still (its first sweep taken from
 // one pose, odometry exact while standing) unless --start moving: a first sweep taken while
 // driving is bent by the odometry's error, no earlier scan can correct it, and de-skewing the
-// later sweeps against it carries its bend on (measured: BENCHMARK.md, "Sweeps taken while driving").
+// later sweeps against it carries its bend on (measured: BENCHMARK.md, "Sweeps taken while
+// driving").
 //   sweep_motion_benchmark --worlds 3 --csv sweep_motion.csv
 #include <algorithm>
 #include <chrono>
@@ -181,10 +182,8 @@ int main(int argc, char** argv) {
       const std::size_t colon = v.find(':');
       if (colon == std::string::npos) throw std::invalid_argument("--max-accepted-wrong: MODE:N");
       wrong_cap_mode = v.substr(0, colon);
-      const double n = io::parseNumber("--max-accepted-wrong", v.substr(colon + 1));
-      if (!(n >= 0 && n == std::floor(n)))
-        throw std::invalid_argument("--max-accepted-wrong: N must be a whole number >= 0");
-      wrong_cap = int(n);
+      wrong_cap = ArgReader::convert<int>("--max-accepted-wrong", v.substr(colon + 1));
+      if (wrong_cap < 0) throw std::invalid_argument("--max-accepted-wrong: N must be >= 0");
     };
     for (ArgReader r(argc, argv); r.more();) {
       if (r.help()) return usage(std::cout), 0;

@@ -4,9 +4,10 @@
 // grazing angles, on a ceiling, on far walls): a surface there sets only some of the cubes it
 // passes through, and which ones depends on where the samples fell. A second sweep taken from
 // the same place samples the same spots, so its sparse samples fall in the same cubes; taken
-// from anywhere else, they fall in other cubes of the same surface. J (section 2.2) therefore has a
-// spike at "no motion" (the scan laid where the reference was taken) that can exceed J at the
-// true motion where structure is weak (docs/experiments.md, "The no-motion maximum and dense_points"). Where a cube
+// from anywhere else, they fall in other cubes of the same surface. J (section 2.2) therefore
+// has a spike at "no motion" (the scan laid where the reference was taken) that can exceed J at
+// the true motion where structure is weak (docs/experiments.md, "The no-motion maximum and
+// dense_points"). Where a cube
 // holds several samples the surface is sampled finer than the cubes, so its cubes are set
 // whatever the sampling: counting only the scan points of such cubes in the coarse search
 // removes the spike and keeps what constrains the pose.
