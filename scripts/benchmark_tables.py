@@ -141,6 +141,9 @@ def repeatability(rows):
 # <folder>.csv, <folder>_<path>_t<threads>.csv, <folder>_seed<N>.csv (scripts/benchmarks.sh)
 BENCH_CSV = (r"(?P<folder>.+?)"
              r"(?:_(?P<path>avx512|avx2|portable)_t(?P<threads>\d+)|_seed(?P<seed>\d+))?\.csv")
+# A folder with more pairs than this (a sequence's consecutive scans) gets one pooled row per
+# method: successes summed, medians over every trial, the worst pair's repeatability.
+MAX_LISTED_PAIRS = 4
 PATHS = (("avx512", "2", "AVX-512, 2 thr"), ("avx2", "2", "AVX2, 2 thr"),
          ("portable", "2", "portable, 2 thr"), ("avx2", "1", "AVX2, 1 thr"),
          ("portable", "1", "portable, 1 thr"))
@@ -169,6 +172,17 @@ def is_cube(method):
     return method.startswith("cubes")
 
 
+def pooled_pair(pairs):
+    return "%d pairs (pooled)" % len(pairs)
+
+
+def pool(groups):
+    """{pair: rows} as is, or {'<n> pairs (pooled)': every row} beyond MAX_LISTED_PAIRS."""
+    if len(groups) <= MAX_LISTED_PAIRS:
+        return groups
+    return {pooled_pair(groups): [r for sel in groups.values() for r in sel]}
+
+
 def accuracy_table(runs):
     print("### Accuracy on real pairs\n")
     print("Each pair from the same seeded guesses (+-1 m / +-8 deg) for every method, in one run "
@@ -181,24 +195,34 @@ def accuracy_table(runs):
     print("|---|---|---|---|---|---|---|---|")
     for folder, path in sorted(runs["main"].items()):
         rows = read_rows(path)
-        for (pair, bounds), pair_rows in grouped(rows, "pair", "bounds").items():
-            cube_time = None
-            for (method,), sel in grouped(pair_rows, "method").items():
-                t = statistics.median(float(r["time_s"]) for r in sel)
-                if is_cube(method) and cube_time is None:
-                    cube_time = t
-                rep = repeatability(sel)
-                sd = [value(r, "sigma_m") for r in sel]
-                sd_cell = ("%.2f cm" % (100 * statistics.median(sd))
-                           if is_cube(method) and None not in sd else "-")
-                print("| %s%s | %s | %d/%d | %.2f cm / %.2f° | %.1f ms | %s | %s | %s |" % (
-                    pair_label(folder, pair), "" if bounds == "big" else " (%s)" % bounds, method,
-                    sum(map(success, sel)), len(sel),
-                    100 * statistics.median(float(r["Es_m"]) for r in sel),
-                    statistics.median(float(r["Ea_deg"]) for r in sel), 1e3 * t,
-                    "%.1f×" % (t / cube_time) if cube_time else "-",
-                    "%.1f mm / %.4f°" % (1e3 * rep[0], rep[1]) if rep else "-", sd_cell))
+        for (bounds,), bound_rows in grouped(rows, "bounds").items():
+            by_pair = {pair: sel for (pair,), sel in grouped(bound_rows, "pair").items()}
+            pooled = len(by_pair) > MAX_LISTED_PAIRS
+            for pair, pair_rows in pool(by_pair).items():
+                accuracy_rows(folder, pair, bounds, pair_rows,
+                              [sel for sel in by_pair.values()] if pooled else [pair_rows])
     print()
+
+
+def accuracy_rows(folder, pair, bounds, pair_rows, per_pair):
+    """One row per method of `pair_rows`; repeatability: the worst of `per_pair`'s groups."""
+    cube_time = None
+    for (method,), sel in grouped(pair_rows, "method").items():
+        t = statistics.median(float(r["time_s"]) for r in sel)
+        if is_cube(method) and cube_time is None:
+            cube_time = t
+        reps = [repeatability([r for r in g if r["method"] == method]) for g in per_pair]
+        rep = None if None in reps else (max(x[0] for x in reps), max(x[1] for x in reps))
+        sd = [value(r, "sigma_m") for r in sel]
+        sd_cell = ("%.2f cm" % (100 * statistics.median(sd))
+                   if is_cube(method) and None not in sd else "-")
+        print("| %s%s | %s | %d/%d | %.2f cm / %.2f° | %.1f ms | %s | %s | %s |" % (
+            pair_label(folder, pair), "" if bounds == "big" else " (%s)" % bounds, method,
+            sum(map(success, sel)), len(sel),
+            100 * statistics.median(float(r["Es_m"]) for r in sel),
+            statistics.median(float(r["Ea_deg"]) for r in sel), 1e3 * t,
+            "%.1f×" % (t / cube_time) if cube_time else "-",
+            "%.1f mm / %.4f°" % (1e3 * rep[0], rep[1]) if rep else "-", sd_cell))
 
 
 def seeds_table(runs):
@@ -217,7 +241,9 @@ def seeds_table(runs):
         for seed, path in by_seed:
             rows = [r for r in read_rows(path) if is_cube(r["method"]) and r["bounds"] == "big"]
             first = rows[0]["method"] if rows else None
-            for (pair,), sel in grouped([r for r in rows if r["method"] == first], "pair").items():
+            by_pair = {pair: sel for (pair,), sel in
+                       grouped([r for r in rows if r["method"] == first], "pair").items()}
+            for pair, sel in pool(by_pair).items():
                 per_pair.setdefault(pair, []).append((seed, sel))
         for pair, seeds in per_pair.items():
             ok = [sum(map(success, sel)) for _, sel in seeds]
@@ -236,9 +262,11 @@ def cube_medians(path):
     """{pair: (median time, successes, trials, rows)} of the first cube method of a run."""
     rows = [r for r in read_rows(path) if is_cube(r["method"]) and r["bounds"] == "big"]
     first = rows[0]["method"] if rows else None
+    by_pair = {pair: sel for (pair,), sel in
+               grouped([r for r in rows if r["method"] == first], "pair").items()}
     return {pair: (statistics.median(float(r["time_s"]) for r in sel), sum(map(success, sel)),
                    len(sel), sel)
-            for (pair,), sel in grouped([r for r in rows if r["method"] == first], "pair").items()}
+            for pair, sel in pool(by_pair).items()}
 
 
 def speed_table(runs):
@@ -545,7 +573,7 @@ RATE_PATTERNS = {
     "registration": r"registration \[ms\]: median ([\d.]+), p95 ([\d.]+)",
     "hwm": r"VmHWM:\s*(\d+) kB",
     "load": r"load average before: (\S+)",
-    "simd": r"SIMD path:? (\w+)",
+    "simd": r"SIMD path:? (\w+)|CSM_SIMD=(\w+)",
 }
 
 
@@ -581,7 +609,8 @@ def rate(out):
             "%s / %s / %s ms" % m["age"].groups() if m["age"] else "-",
             "%s / %s ms" % m["registration"].groups() if m["registration"] else "-",
             "%.1f MB" % (int(m["hwm"].group(1)) / 1024.0) if m["hwm"] else "-",
-            m["load"].group(1) if m["load"] else "?", m["simd"].group(1) if m["simd"] else "?"))
+            m["load"].group(1) if m["load"] else "?",
+            (m["simd"].group(1) or m["simd"].group(2)) if m["simd"] else "?"))
     print()
 
 
