@@ -34,4 +34,22 @@ Matrix6d rotateCovariance(const Matrix6d& covariance, const Eigen::Matrix3d& R_B
   return J * covariance * J.transpose();
 }
 
+Matrix6d compoundCovariance(const Matrix6d& keyframe, const Matrix6d& increment,
+                            const Eigen::Vector3d& lever_arm) {
+  Matrix6d J = Matrix6d::Identity();
+  const Eigen::Vector3d& l = lever_arm;
+  // -[l]x: the translation the keyframe's rotation error dtheta gives the pose, dtheta x l.
+  J.topRightCorner<3, 3>() << 0.0, l.z(), -l.y(), -l.z(), 0.0, l.x(), l.y(), -l.x(), 0.0;
+  const Matrix6d c = J * keyframe * J.transpose() + increment;
+  return 0.5 * (c + c.transpose());
+}
+
+Matrix6d twistCovariance(const Matrix6d& pose_covariance, double interval,
+                         const Eigen::Matrix<double, 6, 1>& velocity_change) {
+  // Symmetric to the last bit (a rotated covariance is not, by rounding): filters check it.
+  Matrix6d c = (pose_covariance + pose_covariance.transpose()) / (interval * interval);
+  c.diagonal() += velocity_change.cwiseAbs2();
+  return c;
+}
+
 }  // namespace cube_scan_matcher

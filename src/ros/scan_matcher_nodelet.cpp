@@ -24,7 +24,8 @@ namespace {
 
 geometry_msgs::Pose toPoseMsg(const Eigen::Isometry3d& T) { return tf2::toMsg(T); }
 
-/// A covariance in PoseWithCovariance's row-major order [x y z, rotation about x y z].
+/// A covariance in PoseWithCovariance's and TwistWithCovariance's row-major order
+/// [x y z, rotation about x y z].
 boost::array<double, 36> toMsg(const Matrix6d& c) {
   boost::array<double, 36> m{};
   for (int i = 0; i < 6; ++i) {
@@ -33,9 +34,12 @@ boost::array<double, 36> toMsg(const Matrix6d& c) {
   return m;
 }
 
-/// Diagonal covariance [x y z roll pitch yaw] from standard deviations [m] and [deg].
-boost::array<double, 36> covariance(double sigma_m, double sigma_deg) {
-  return toMsg(diagonalCovariance(sigma_m, deg2rad(sigma_deg)));
+/// A twist [vx vy vz, wx wy wz] [m/s, rad/s] as a message.
+geometry_msgs::Twist toTwistMsg(const Vector6d& v) {
+  geometry_msgs::Twist t;
+  t.linear.x = v(0), t.linear.y = v(1), t.linear.z = v(2);
+  t.angular.x = v(3), t.angular.y = v(4), t.angular.z = v(5);
+  return t;
 }
 
 }  // namespace
@@ -50,6 +54,7 @@ ScanMatcherNodelet::~ScanMatcherNodelet() {
   cloud_sub_.shutdown();
   reset_srv_.shutdown();
   set_pose_srv_.shutdown();
+  initialpose_sub_.shutdown();
   reconfigure_server_.reset();
 }
 
@@ -109,6 +114,7 @@ void ScanMatcherNodelet::onInit() {
   // Subscribe last: callbacks may start at once.
   cloud_sub_ = nh.subscribe("cloud", std::uint32_t(params_.queue_size),
                             &ScanMatcherNodelet::cloudCallback, this);
+  initialpose_sub_ = nh.subscribe("initialpose", 1, &ScanMatcherNodelet::initialPoseCallback, this);
   NODELET_INFO(
       "ScanMatcherNodelet: registering %s in %s (odometry %s, poses in %s), E = %.2f m, "
       "SIMD path %s",
@@ -142,39 +148,73 @@ bool ScanMatcherNodelet::resetService(std_srvs::Trigger::Request&, std_srvs::Tri
 }
 
 bool ScanMatcherNodelet::setPoseService(SetPose::Request& req, SetPose::Response& res) {
-  const auto& p = req.pose.pose.pose;
+  std::lock_guard<std::mutex> lock(mutex_);
+  const std::string refused = restartChain(req.pose, "~set_pose");
+  res.success = refused.empty();
+  res.message = res.success ? "the next scan starts a new chain at the given pose" : refused;
+  if (!res.success) NODELET_WARN("~set_pose refused: %s", refused.c_str());
+  return true;
+}
+
+void ScanMatcherNodelet::initialPoseCallback(
+    const geometry_msgs::PoseWithCovarianceStampedConstPtr& msg) {
+  // RViz's "2D Pose Estimate" gives x, y and yaw on the ground plane (z 0, level): a 3D chain
+  // keeps z, roll and pitch of its last pose (none before the first scan: 0), and their
+  // variances stay the configured ones.
+  std::lock_guard<std::mutex> lock(mutex_);
+  geometry_msgs::PoseWithCovarianceStamped pose = *msg;
+  const auto& o = msg->pose.pose.orientation;
+  const Eigen::Quaterniond q(o.w, o.x, o.y, o.z);
+  if (q.coeffs().allFinite() && q.norm() > 0.5) {
+    // Yaw of a rotation: the heading of its x axis on the ground plane (z-y-x Euler order).
+    auto yaw = [](const Eigen::Matrix3d& R) { return std::atan2(R(1, 0), R(0, 0)); };
+    const Eigen::Isometry3d last = last_pose_.value_or(Eigen::Isometry3d::Identity());
+    const Eigen::Quaterniond merged(
+        Eigen::AngleAxisd(yaw(q.normalized().toRotationMatrix()) - yaw(last.linear()),
+                          Eigen::Vector3d::UnitZ()) *
+        Eigen::Quaterniond(last.linear()));
+    pose.pose.pose.orientation.w = merged.w(), pose.pose.pose.orientation.x = merged.x();
+    pose.pose.pose.orientation.y = merged.y(), pose.pose.pose.orientation.z = merged.z();
+    pose.pose.pose.position.z = last.translation().z();
+    for (const int i : {2, 3, 4}) {  // z, roll, pitch: not given, so not known better than sigma
+      for (int j = 0; j < 6; ++j) pose.pose.covariance[std::size_t(6 * i + j)] = 0.0;
+      for (int j = 0; j < 6; ++j) pose.pose.covariance[std::size_t(6 * j + i)] = 0.0;
+    }
+  }
+  const std::string refused = restartChain(pose, "initialpose");
+  if (!refused.empty()) NODELET_WARN("initialpose refused: %s", refused.c_str());
+}
+
+std::string ScanMatcherNodelet::restartChain(const geometry_msgs::PoseWithCovarianceStamped& req,
+                                             const std::string& source) {
+  const auto& p = req.pose.pose;
   const Eigen::Quaterniond q(p.orientation.w, p.orientation.x, p.orientation.y, p.orientation.z);
   const Eigen::Vector3d t(p.position.x, p.position.y, p.position.z);
-  res.success = false;
-  if (!req.pose.header.frame_id.empty() && req.pose.header.frame_id != params_.map_frame) {
-    res.message = "pose must be in map_frame '" + params_.map_frame + "', not '" +
-                  req.pose.header.frame_id + "'";
-  } else if (!t.allFinite() || !q.coeffs().allFinite() || std::abs(q.norm() - 1.0) > 1e-3) {
-    res.message = "pose must be finite with a unit quaternion";
-  } else {
-    std::lock_guard<std::mutex> lock(mutex_);
-    resetState("pose set through ~set_pose");
-    Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();
-    pose.linear() = q.normalized().toRotationMatrix();
-    pose.translation() = t;
-    matcher_->restartAt(pose);
-    // The request's covariance; a variance it leaves at 0 (unknown) becomes the configured one.
-    const auto& c = req.pose.pose.covariance;
-    Matrix6d start = Matrix6d::Zero();
-    for (int i = 0; i < 6; ++i) {
-      for (int j = 0; j < 6; ++j) start(i, j) = c[std::size_t(6 * i + j)];
-    }
-    start = 0.5 * (start + start.transpose());
-    const Matrix6d floors = diagonalCovariance(params_.sigma_translation, deg2rad(params_.sigma_rotation));
-    for (int i = 0; i < 6; ++i) {
-      if (!(start(i, i) > 0.0)) start(i, i) = floors(i, i);
-    }
-    start_cov_ = start;
-    res.success = true;
-    res.message = "the next scan starts a new chain at the given pose";
+  if (!req.header.frame_id.empty() && req.header.frame_id != params_.map_frame) {
+    return "pose must be in map_frame '" + params_.map_frame + "', not '" + req.header.frame_id +
+           "'";
   }
-  if (!res.success) NODELET_WARN("~set_pose refused: %s", res.message.c_str());
-  return true;
+  if (!t.allFinite() || !q.coeffs().allFinite() || std::abs(q.norm() - 1.0) > 1e-3) {
+    return "pose must be finite with a unit quaternion";
+  }
+  resetState("pose set through " + source);
+  Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();
+  pose.linear() = q.normalized().toRotationMatrix();
+  pose.translation() = t;
+  matcher_->restartAt(pose);
+  // The request's covariance; a variance it leaves at 0 (unknown) becomes the configured one.
+  const auto& c = req.pose.covariance;
+  Matrix6d start = Matrix6d::Zero();
+  for (int i = 0; i < 6; ++i) {
+    for (int j = 0; j < 6; ++j) start(i, j) = c[std::size_t(6 * i + j)];
+  }
+  start = 0.5 * (start + start.transpose());
+  const Matrix6d floors = diagonalCovariance(params_.sigma_translation, deg2rad(params_.sigma_rotation));
+  for (int i = 0; i < 6; ++i) {
+    if (!(start(i, i) > 0.0)) start(i, i) = floors(i, i);
+  }
+  start_cov_ = start;
+  return "";
 }
 
 void ScanMatcherNodelet::resetState(const std::string& why) {
@@ -186,6 +226,8 @@ void ScanMatcherNodelet::resetState(const std::string& why) {
   dropped_ = rejected_ = tf_failures_ = processed_ = bad_input_ = consecutive_rejections_ = 0;
   latencies_.clear();
   start_cov_.reset();
+  last_twist_.reset();
+  last_pose_.reset();
 }
 
 std::optional<Eigen::Isometry3d> ScanMatcherNodelet::lookup(const std::string& target,
@@ -414,25 +456,28 @@ OnlineStep ScanMatcherNodelet::registerScan(Scan& scan) {
 }
 
 void ScanMatcherNodelet::publishPose(const Scan& scan, const OnlineStep& step) {
-  // Covariance along the chain of keyframes: a scan's pose is its keyframe's plus one
-  // increment. An accepted increment carries the registration's covariance (the polish's,
-  // rotated from the keyframe's axes into the map's) with the configured sigmas as a floor;
-  // one propagated by odometry carries (rejected_sigma_scale * sigma)^2. A new keyframe keeps
-  // its covariance; a chain starts at sigma^2 (or the ~set_pose covariance). Standing still
-  // (no new keyframe) the covariance does not grow. First order: the lever arm of the
-  // keyframe's rotation error is not propagated.
+  // Covariance along the chain of keyframes: a scan's pose is its keyframe's times one
+  // increment (compoundCovariance: the keyframe's rotation error moves the pose through the
+  // lever arm of the increment). An accepted increment carries the registration's covariance
+  // (the polish's, rotated from the keyframe's axes into the map's) with the configured sigmas
+  // as a floor; one propagated by odometry carries (rejected_sigma_scale * sigma)^2. A new
+  // keyframe keeps its covariance; a chain starts at sigma^2 (or the ~set_pose covariance).
+  // Standing still (no new keyframe) the covariance does not grow.
   const double st = params_.sigma_translation, sr = deg2rad(params_.sigma_rotation);
+  const Eigen::Isometry3d keyframe = step.pose * step.increment.inverse();  // T_map_keyframe
+  const Eigen::Vector3d lever_arm = step.pose.translation() - keyframe.translation();
   Matrix6d cov;
   if (step.reason == GateReason::FirstScan) {
     cov = start_cov_ ? *start_cov_ : diagonalCovariance(st, sr);
     start_cov_.reset();
   } else if (step.accepted) {
-    const Eigen::Matrix3d R_map_keyframe = (step.pose * step.increment.inverse()).linear();
-    cov = keyframe_cov_ +
-          rotateCovariance(floorCovariance(step.result.covariance, st, sr), R_map_keyframe);
+    cov = compoundCovariance(
+        keyframe_cov_,
+        rotateCovariance(floorCovariance(step.result.covariance, st, sr), keyframe.linear()),
+        lever_arm);
   } else {
     const double scale = params_.rejected_sigma_scale;
-    cov = keyframe_cov_ + diagonalCovariance(scale * st, scale * sr);
+    cov = compoundCovariance(keyframe_cov_, diagonalCovariance(scale * st, scale * sr), lever_arm);
   }
   if (step.reference_updated) keyframe_cov_ = cov;
   std_msgs::Header header;
@@ -444,27 +489,29 @@ void ScanMatcherNodelet::publishPose(const Scan& scan, const OnlineStep& step) {
   pose.pose.pose = toPoseMsg(step.pose);
   pose.pose.covariance = toMsg(cov);
   pose_pub_.publish(pose);
+  last_pose_ = step.pose;
 
   nav_msgs::Odometry odometry;
   odometry.header = header;
   odometry.child_frame_id = params_.base_frame;
   odometry.pose = pose.pose;
+  odometry.twist.twist = toTwistMsg(Vector6d::Zero());
+  odometry.twist.covariance = toMsg(Matrix6d(kUnknownTwistVariance * Matrix6d::Identity()));
+  if (step.reason == GateReason::FirstScan) last_twist_.reset();
   if (step.accepted && step.interval > 0.0) {
     // Mean velocity since the last registered scan, in base_frame at this scan: v = R^T t / dt,
     // w = theta / dt (the rotation vector is the same in both frames: it lies on the axis).
-    const Eigen::Vector3d v =
-        step.motion.linear().transpose() * step.motion.translation() / step.interval;
     const Eigen::AngleAxisd aa(step.motion.linear());
-    const Eigen::Vector3d w = aa.axis() * aa.angle() / step.interval;
-    odometry.twist.twist.linear.x = v.x(), odometry.twist.twist.linear.y = v.y();
-    odometry.twist.twist.linear.z = v.z();
-    odometry.twist.twist.angular.x = w.x(), odometry.twist.twist.angular.y = w.y();
-    odometry.twist.twist.angular.z = w.z();
-    // Two pose errors over the interval.
-    odometry.twist.covariance = covariance(std::sqrt(2.0) * params_.sigma_translation / step.interval,
-                                           std::sqrt(2.0) * params_.sigma_rotation / step.interval);
-  } else {
-    odometry.twist.covariance[0] = -1.0;  // no twist estimate for this scan
+    Vector6d twist;
+    twist << step.motion.linear().transpose() * step.motion.translation() / step.interval,
+        aa.axis() * aa.angle() / step.interval;
+    // The registration's covariance (keyframe axes, floored) in base_frame's axes.
+    const Matrix6d registered = rotateCovariance(floorCovariance(step.result.covariance, st, sr),
+                                                 step.increment.linear().transpose());
+    odometry.twist.twist = toTwistMsg(twist);
+    odometry.twist.covariance = toMsg(
+        twistCovariance(registered, step.interval, twist - last_twist_.value_or(Vector6d::Zero())));
+    last_twist_ = twist;
   }
   odom_pub_.publish(odometry);
 

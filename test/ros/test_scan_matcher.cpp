@@ -5,6 +5,7 @@
 // of bad input.
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <limits>
 #include <random>
 
@@ -22,6 +23,7 @@
 
 #include "cube_scan_matcher/Status.h"
 #include "cube_scan_matcher/core/pose.h"
+#include "cube_scan_matcher/core/pose_covariance.h"
 #include "cube_scan_matcher/ros/cloud_conversion.h"
 #include "cube_scan_matcher/ros/params.h"
 #include "cube_scan_matcher/ros/transforms.h"
@@ -37,6 +39,19 @@ WorstError worst;  // printed at exit
 namespace {
 
 const std::string kNs = "/scan_matcher/";
+
+/// A simulated sweep of `scene` from the body pose `body`, its points in base_link (the laser
+/// at base_link's origin, turned by sim::sensorToBodyRotation).
+PointArray sweepInBase(const sim::Scene& scene, const Eigen::Isometry3d& body, std::mt19937_64& rng) {
+  Eigen::Isometry3d mount = Eigen::Isometry3d::Identity();
+  mount.linear() = sim::sensorToBodyRotation();
+  PointArray pts = sim::scan(scene, sim::ScannerModel{}, body * mount, rng);
+  for (std::size_t i = 0; i < pts.size(); ++i) {
+    const Eigen::Vector3f p = mount.cast<float>() * pts.point(i);
+    pts.x[i] = p.x(), pts.y[i] = p.y(), pts.z[i] = p.z();
+  }
+  return pts;
+}
 
 class ScanMatcherRos : public ::testing::Test {
  protected:
@@ -169,13 +184,7 @@ TEST_F(ScanMatcherRos, BadInputKeepsTheNodeAliveAndIsReported) {
   Eigen::Isometry3d body = Eigen::Isometry3d::Identity();
   body.translation() = Eigen::Vector3d(2, 1, 1);
   body.linear() = rotationFromRpy(0, 0, deg2rad(17));
-  Eigen::Isometry3d mount = Eigen::Isometry3d::Identity();
-  mount.linear() = sim::sensorToBodyRotation();
-  PointArray good = sim::scan(scene, sim::ScannerModel{}, body * mount, rng);
-  for (std::size_t i = 0; i < good.size(); ++i) {  // into base_link
-    const Eigen::Vector3f p = mount.cast<float>() * good.point(i);
-    good.x[i] = p.x(), good.y[i] = p.y(), good.z[i] = p.z();
-  }
+  const PointArray good = sweepInBase(scene, body, rng);
   ros::Time stamp = ros::Time::now();
   auto next = [&] {
     stamp += ros::Duration(0.5);
@@ -256,6 +265,158 @@ TEST_F(ScanMatcherRos, BadInputKeepsTheNodeAliveAndIsReported) {
   stamp = ros::Time::now() + ros::Duration(1.0);
   s = send(makeCloud(good, "base_link", next()));
   EXPECT_EQ(s.reason, Status::ACCEPTED) << s.message;
+}
+
+/// The odometry message published for the cloud stamped `stamp`, waiting up to 10 s.
+const nav_msgs::Odometry* odometryAt(Outputs& out, const ros::Time& stamp) {
+  const nav_msgs::Odometry* found = nullptr;
+  waitFor([&] {
+    for (const auto& o : out.odom) {
+      if (o.header.stamp == stamp) found = &o;
+    }
+    return found != nullptr;
+  }, 10.0);
+  return found;
+}
+
+/// A twist a filter can fuse: every variance positive and finite; `unknown`: zero velocity with
+/// kUnknownTwistVariance on every diagonal entry and nothing off it.
+void expectFusableTwist(const nav_msgs::Odometry& o, bool unknown, const std::string& what) {
+  for (int i = 0; i < 6; ++i) {
+    const double var = o.twist.covariance[std::size_t(7 * i)];
+    EXPECT_TRUE(std::isfinite(var) && var > 0.0) << what << ": twist variance " << i << " = " << var;
+    for (int j = 0; j < 6; ++j) {
+      EXPECT_EQ(o.twist.covariance[std::size_t(6 * i + j)], o.twist.covariance[std::size_t(6 * j + i)])
+          << what << ": not symmetric";
+      if (unknown && i != j) {
+        EXPECT_EQ(o.twist.covariance[std::size_t(6 * i + j)], 0.0) << what;
+      }
+    }
+    if (unknown) {
+      EXPECT_EQ(var, kUnknownTwistVariance) << what << ": variance " << i;
+    } else {
+      EXPECT_LT(var, kUnknownTwistVariance) << what << ": variance " << i << " of a known twist";
+    }
+  }
+  const auto& t = o.twist.twist;
+  if (unknown) {
+    EXPECT_EQ(t.linear.x, 0.0) << what;
+    EXPECT_EQ(t.linear.y, 0.0) << what;
+    EXPECT_EQ(t.angular.z, 0.0) << what;
+  }
+}
+
+// ~odometry on a first, an accepted and a rejected scan: a twist is known only after an
+// accepted registration; otherwise it is published as unknown (never a zero or negative
+// variance, which robot_localization would read as a certain zero velocity).
+TEST_F(ScanMatcherRos, OdometryTwistIsFusableOnEveryScan) {
+  const sim::Scene scene = sim::Scene::generate(sim::SceneType::Urban, 3);
+  std::mt19937_64 rng(5);
+  Eigen::Isometry3d body = Eigen::Isometry3d::Identity();
+  body.linear() = rotationFromRpy(0.0, 0.0, deg2rad(17));
+  body.translation() = Eigen::Vector3d(3, 1, scene.groundHeight(3, 1) + 0.5);
+  auto scanAt = [&](const Eigen::Isometry3d& b) { return sweepInBase(scene, b, rng); };
+  auto ahead = [&](const Eigen::Isometry3d& b, double metres) {  // along the body's x axis
+    Eigen::Isometry3d n = b;
+    n.translation() += metres * b.linear().col(0);
+    n.translation().z() = scene.groundHeight(n.translation().x(), n.translation().y()) + 0.5;
+    return n;
+  };
+  ros::Time stamp = ros::Time::now();
+  // Odometry = truth; the robot drives 0.5 m along x per 0.5 s (1 m/s).
+  auto sendAt = [&](const Eigen::Isometry3d& odom, const PointArray& pts) {
+    stamp += ros::Duration(0.5);
+    tf_pub.sendTransform(stampedTransform(odom, "odom", "base_link", stamp));
+    waitFor([] { return false; }, 0.1);
+    const Status s = send(makeCloud(pts, "base_link", stamp));
+    const nav_msgs::Odometry* o = odometryAt(out, stamp);
+    EXPECT_NE(o, nullptr) << "no ~odometry for the scan at " << stamp;
+    return std::make_pair(s, o ? *o : nav_msgs::Odometry{});
+  };
+  auto [first, o_first] = sendAt(body, scanAt(body));
+  EXPECT_EQ(first.reason, Status::FIRST_SCAN) << first.message;
+  expectFusableTwist(o_first, true, "first scan");
+
+  Eigen::Isometry3d moved = ahead(body, 0.5);
+  auto [accepted, o_accepted] = sendAt(moved, scanAt(moved));
+  EXPECT_EQ(accepted.reason, Status::ACCEPTED) << accepted.message;
+  expectFusableTwist(o_accepted, false, "accepted scan");
+  EXPECT_NEAR(o_accepted.twist.twist.linear.x, 1.0, 0.05);
+  // The motion model's error: the first twist after a chain's start changed from an unknown
+  // one, taken as 0, so its variance holds the whole velocity squared.
+  EXPECT_GT(o_accepted.twist.covariance[0], 0.9);
+
+  // The scan shows the robot 5 m further than the odometry says: beyond the gate's correction
+  // bound, so rejected, and its twist is unknown.
+  const Eigen::Isometry3d far = ahead(moved, 5.5);
+  moved = ahead(moved, 0.5);
+  auto [rejected, o_rejected] = sendAt(moved, scanAt(far));
+  EXPECT_NE(rejected.reason, Status::ACCEPTED) << rejected.message;
+  EXPECT_NE(rejected.reason, Status::FIRST_SCAN) << rejected.message;
+  EXPECT_NE(rejected.reason, Status::BAD_INPUT) << rejected.message;
+  expectFusableTwist(o_rejected, true, "rejected scan");
+
+  // Accepted again at the same speed: the change from the last known twist is small now.
+  moved = ahead(moved, 0.5);
+  auto [again, o_again] = sendAt(moved, scanAt(moved));
+  EXPECT_EQ(again.reason, Status::ACCEPTED) << again.message;
+  expectFusableTwist(o_again, false, "accepted scan after a rejection");
+  EXPECT_NEAR(o_again.twist.twist.linear.x, 1.0, 0.05);
+  EXPECT_LT(o_again.twist.covariance[0], 0.05);
+}
+
+// RViz's "2D Pose Estimate" on /initialpose: the next scan starts a new chain at the given x,
+// y and yaw, keeping the last pose's z, roll and pitch; a pose in another frame is refused.
+TEST_F(ScanMatcherRos, InitialPoseRestartsTheChainOnTheGroundPlane) {
+  ros::Publisher initial = nh.advertise<geometry_msgs::PoseWithCovarianceStamped>("/initialpose", 1);
+  ASSERT_TRUE(waitFor([&] { return initial.getNumSubscribers() > 0; }, 10.0))
+      << "the scan matcher did not subscribe to /initialpose";
+  const sim::Scene scene = sim::Scene::generate(sim::SceneType::Urban, 3);
+  std::mt19937_64 rng(9);
+  Eigen::Isometry3d body = Eigen::Isometry3d::Identity();
+  body.linear() = rotationFromRpy(0.02, -0.03, deg2rad(17));
+  body.translation() = Eigen::Vector3d(3, 1, scene.groundHeight(3, 1) + 0.5);
+  const PointArray pts = sweepInBase(scene, body, rng);
+  ros::Time stamp = ros::Time::now();
+  auto sendScan = [&] {
+    stamp += ros::Duration(0.5);
+    tf_pub.sendTransform(stampedTransform(body, "odom", "base_link", stamp));
+    waitFor([] { return false; }, 0.1);
+    return send(makeCloud(pts, "base_link", stamp));
+  };
+  EXPECT_EQ(sendScan().reason, Status::FIRST_SCAN);  // the chain starts at the odometry pose
+  EXPECT_EQ(sendScan().reason, Status::ACCEPTED);
+
+  auto publishInitial = [&](const std::string& frame) {
+    geometry_msgs::PoseWithCovarianceStamped m;
+    m.header.frame_id = frame;
+    m.header.stamp = ros::Time::now();
+    m.pose.pose.position.x = 10.0, m.pose.pose.position.y = -4.0;  // z 0, level: as RViz sends
+    const Eigen::Quaterniond q(Eigen::AngleAxisd(deg2rad(-60), Eigen::Vector3d::UnitZ()));
+    m.pose.pose.orientation.w = q.w(), m.pose.pose.orientation.z = q.z();
+    m.pose.covariance[0] = m.pose.covariance[7] = 0.25;  // RViz's 0.5 m
+    initial.publish(m);
+    waitFor([] { return false; }, 0.5);
+  };
+  publishInitial("not_the_map");  // refused: the chain goes on
+  EXPECT_EQ(sendScan().reason, Status::ACCEPTED);
+
+  publishInitial("map");
+  const Status s = sendScan();
+  EXPECT_EQ(s.reason, Status::FIRST_SCAN) << s.message;
+  ASSERT_TRUE(waitFor([&] { return !out.pose.empty() && out.pose.back().header.stamp == stamp; }, 10.0));
+  const auto& p = out.pose.back();
+  Eigen::Isometry3d est;
+  tf2::fromMsg(p.pose.pose, est);
+  EXPECT_NEAR(est.translation().x(), 10.0, 1e-9);
+  EXPECT_NEAR(est.translation().y(), -4.0, 1e-9);
+  EXPECT_NEAR(est.translation().z(), body.translation().z(), 0.01);  // kept, not RViz's 0
+  const Eigen::Matrix3d expected =
+      rotationFromRpy(0.0, 0.0, deg2rad(-60)) * rotationFromRpy(0.0, 0.0, deg2rad(17)).transpose() *
+      body.linear();  // the given yaw, the last pose's roll and pitch
+  EXPECT_LT(rad2deg(Eigen::AngleAxisd(expected.transpose() * est.linear()).angle()), 0.5);
+  EXPECT_NEAR(p.pose.covariance[0], 0.25, 1e-12);  // given
+  EXPECT_GT(p.pose.covariance[14], 0.0);            // z: the configured sigma, not RViz's 0
 }
 
 // Run alone with a bad parameter (test/ros/bad_param.test): the matcher refuses to start and

@@ -15,8 +15,10 @@
 #include <diagnostic_updater/diagnostic_updater.h>
 #include <diagnostic_updater/update_functions.h>
 #include <dynamic_reconfigure/server.h>
+#include <geometry_msgs/PoseWithCovarianceStamped.h>
 #include <nav_msgs/Path.h>
 #include <nodelet/nodelet.h>
+#include <geometry_msgs/PoseWithCovarianceStamped.h>
 #include <ros/ros.h>
 #include <sensor_msgs/PointCloud2.h>
 #include <std_srvs/Trigger.h>
@@ -29,6 +31,7 @@
 #include "cube_scan_matcher/Status.h"
 #include "cube_scan_matcher/core/online_matcher.h"
 #include "cube_scan_matcher/core/pose_covariance.h"
+#include "cube_scan_matcher/core/vector6.h"
 #include "cube_scan_matcher/ros/nodelet_queues.h"
 #include "cube_scan_matcher/ros/params.h"
 
@@ -67,6 +70,12 @@ class ScanMatcherNodelet : public nodelet::Nodelet {
   void rejectInput(Scan& scan, const std::string& why);
   bool resetService(std_srvs::Trigger::Request& req, std_srvs::Trigger::Response& res);
   bool setPoseService(SetPose::Request& req, SetPose::Response& res);
+  /// RViz's "2D Pose Estimate" (topic initialpose): x, y and yaw restart the chain.
+  void initialPoseCallback(const geometry_msgs::PoseWithCovarianceStampedConstPtr& msg);
+  /// ~set_pose and initialpose: the next scan starts a new chain at `pose` (map_frame); the
+  /// reason it was refused, or empty.
+  std::string restartChain(const geometry_msgs::PoseWithCovarianceStamped& pose,
+                           const std::string& source);
   void reconfigure(ScanMatcherConfig& config, uint32_t level);
   /// T_target_source at `stamp`, waiting at most ~tf_timeout; nullopt (and counted) on failure.
   std::optional<Eigen::Isometry3d> lookup(const std::string& target, const std::string& source,
@@ -83,7 +92,7 @@ class ScanMatcherNodelet : public nodelet::Nodelet {
   std::unique_ptr<tf2_ros::Buffer> tf_buffer_;
   std::unique_ptr<tf2_ros::TransformListener> tf_listener_;
   std::unique_ptr<tf2_ros::TransformBroadcaster> tf_broadcaster_;
-  ros::Subscriber cloud_sub_;
+  ros::Subscriber cloud_sub_, initialpose_sub_;
   ros::Publisher pose_pub_, odom_pub_, path_pub_, cloud_pub_, status_pub_;
   ros::ServiceServer reset_srv_, set_pose_srv_;
   std::unique_ptr<dynamic_reconfigure::Server<ScanMatcherConfig>> reconfigure_server_;
@@ -101,10 +110,14 @@ class ScanMatcherNodelet : public nodelet::Nodelet {
   ros::Timer tf_timer_;
 
   // Covariance of the current keyframe's pose in the map frame (pose_covariance.h): a scan's
-  // published covariance is this plus its increment's; it grows from keyframe to keyframe (a
-  // random walk of the increments' errors) and restarts at the first scan of a chain.
+  // published covariance is this compounded with its increment's (compoundCovariance); it grows
+  // from keyframe to keyframe and restarts at the first scan of a chain.
   Matrix6d keyframe_cov_ = Matrix6d::Zero();
   std::optional<Matrix6d> start_cov_;  // from ~set_pose, for the next first scan
+  // The last twist published with an estimate [m/s, rad/s] in base_frame (none at a chain's
+  // start): its change to the next one is the motion model's error (twistCovariance).
+  std::optional<Vector6d> last_twist_;
+  std::optional<Eigen::Isometry3d> last_pose_;  // T_map_base published last (this chain)
 
   nav_msgs::Path path_;
   std::optional<std::uint32_t> last_seq_;
