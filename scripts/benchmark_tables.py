@@ -172,15 +172,16 @@ def is_cube(method):
     return method.startswith("cubes")
 
 
-def pooled_pair(pairs):
-    return "%d pairs (pooled)" % len(pairs)
+def by_pair(rows):
+    """{pair: its rows}."""
+    return {pair: sel for (pair,), sel in grouped(rows, "pair").items()}
 
 
 def pool(groups):
     """{pair: rows} as is, or {'<n> pairs (pooled)': every row} beyond MAX_LISTED_PAIRS."""
     if len(groups) <= MAX_LISTED_PAIRS:
         return groups
-    return {pooled_pair(groups): [r for sel in groups.values() for r in sel]}
+    return {"%d pairs (pooled)" % len(groups): [r for sel in groups.values() for r in sel]}
 
 
 def accuracy_table(runs):
@@ -196,11 +197,11 @@ def accuracy_table(runs):
     for folder, path in sorted(runs["main"].items()):
         rows = read_rows(path)
         for (bounds,), bound_rows in grouped(rows, "bounds").items():
-            by_pair = {pair: sel for (pair,), sel in grouped(bound_rows, "pair").items()}
-            pooled = len(by_pair) > MAX_LISTED_PAIRS
-            for pair, pair_rows in pool(by_pair).items():
+            pairs = by_pair(bound_rows)
+            pooled = len(pairs) > MAX_LISTED_PAIRS
+            for pair, pair_rows in pool(pairs).items():
                 accuracy_rows(folder, pair, bounds, pair_rows,
-                              [sel for sel in by_pair.values()] if pooled else [pair_rows])
+                              list(pairs.values()) if pooled else [pair_rows])
     print()
 
 
@@ -241,9 +242,7 @@ def seeds_table(runs):
         for seed, path in by_seed:
             rows = [r for r in read_rows(path) if is_cube(r["method"]) and r["bounds"] == "big"]
             first = rows[0]["method"] if rows else None
-            by_pair = {pair: sel for (pair,), sel in
-                       grouped([r for r in rows if r["method"] == first], "pair").items()}
-            for pair, sel in pool(by_pair).items():
+            for pair, sel in pool(by_pair([r for r in rows if r["method"] == first])).items():
                 per_pair.setdefault(pair, []).append((seed, sel))
         for pair, seeds in per_pair.items():
             ok = [sum(map(success, sel)) for _, sel in seeds]
@@ -262,11 +261,9 @@ def cube_medians(path):
     """{pair: (median time, successes, trials, rows)} of the first cube method of a run."""
     rows = [r for r in read_rows(path) if is_cube(r["method"]) and r["bounds"] == "big"]
     first = rows[0]["method"] if rows else None
-    by_pair = {pair: sel for (pair,), sel in
-               grouped([r for r in rows if r["method"] == first], "pair").items()}
     return {pair: (statistics.median(float(r["time_s"]) for r in sel), sum(map(success, sel)),
                    len(sel), sel)
-            for pair, sel in pool(by_pair).items()}
+            for pair, sel in pool(by_pair([r for r in rows if r["method"] == first])).items()}
 
 
 def speed_table(runs):

@@ -466,15 +466,15 @@ void ScanMatcherNodelet::publishPose(const Scan& scan, const OnlineStep& step) {
   const double st = params_.sigma_translation, sr = deg2rad(params_.sigma_rotation);
   const Eigen::Isometry3d keyframe = step.pose * step.increment.inverse();  // T_map_keyframe
   const Eigen::Vector3d lever_arm = step.pose.translation() - keyframe.translation();
+  // The registration's covariance in the keyframe's axes, floored (used when accepted).
+  const Matrix6d registered = floorCovariance(step.result.covariance, st, sr);
   Matrix6d cov;
   if (step.reason == GateReason::FirstScan) {
     cov = start_cov_ ? *start_cov_ : diagonalCovariance(st, sr);
     start_cov_.reset();
   } else if (step.accepted) {
-    cov = compoundCovariance(
-        keyframe_cov_,
-        rotateCovariance(floorCovariance(step.result.covariance, st, sr), keyframe.linear()),
-        lever_arm);
+    cov = compoundCovariance(keyframe_cov_, rotateCovariance(registered, keyframe.linear()),
+                             lever_arm);
   } else {
     const double scale = params_.rejected_sigma_scale;
     cov = compoundCovariance(keyframe_cov_, diagonalCovariance(scale * st, scale * sr), lever_arm);
@@ -505,12 +505,10 @@ void ScanMatcherNodelet::publishPose(const Scan& scan, const OnlineStep& step) {
     Vector6d twist;
     twist << step.motion.linear().transpose() * step.motion.translation() / step.interval,
         aa.axis() * aa.angle() / step.interval;
-    // The registration's covariance (keyframe axes, floored) in base_frame's axes.
-    const Matrix6d registered = rotateCovariance(floorCovariance(step.result.covariance, st, sr),
-                                                 step.increment.linear().transpose());
     odometry.twist.twist = toTwistMsg(twist);
-    odometry.twist.covariance = toMsg(
-        twistCovariance(registered, step.interval, twist - last_twist_.value_or(Vector6d::Zero())));
+    odometry.twist.covariance = toMsg(twistCovariance(
+        rotateCovariance(registered, step.increment.linear().transpose()),  // base_frame axes
+        step.interval, twist - last_twist_.value_or(Vector6d::Zero())));
     last_twist_ = twist;
   }
   odom_pub_.publish(odometry);

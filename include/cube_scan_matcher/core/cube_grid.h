@@ -26,7 +26,8 @@ struct CubeGridSettings {
   /// Beyond the paper: an objective's working copy of V uses one byte per cube (about 1.8x
   /// faster counting; docs/experiments.md, "Where the time went") for grids of up to this
   /// many cubes, and V's one bit per cube above. Each thread of the search owns one working
-  /// copy per grid, so this bounds that memory at max_byte_cubes bytes per copy. 0 = always bits. In [0, 2^28].
+  /// copy per grid, so this bounds that memory at max_byte_cubes bytes per copy. 0 = always
+  /// bits. In [0, 2^28].
   std::uint64_t max_byte_cubes = std::uint64_t{1} << 22;
   /// Beyond the paper: the grid origin is moved to min - origin_shift * E (same on all axes),
   /// in [0, 1). Grids with different shifts cut space at different places; summing their J

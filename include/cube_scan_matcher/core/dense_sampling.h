@@ -7,10 +7,9 @@
 // from anywhere else, they fall in other cubes of the same surface. J (section 2.2) therefore
 // has a spike at "no motion" (the scan laid where the reference was taken) that can exceed J at
 // the true motion where structure is weak (docs/experiments.md, "The no-motion maximum and
-// dense_points"). Where a cube
-// holds several samples the surface is sampled finer than the cubes, so its cubes are set
-// whatever the sampling: counting only the scan points of such cubes in the coarse search
-// removes the spike and keeps what constrains the pose.
+// dense_points"). Where a cube holds several samples the surface is sampled finer than the
+// cubes, so its cubes are set whatever the sampling: counting only the scan points of such
+// cubes in the coarse search removes the spike and keeps what constrains the pose.
 #pragma once
 
 #include <cstddef>
