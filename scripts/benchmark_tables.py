@@ -26,7 +26,7 @@ import plot_scenes  # noqa: E402  (--targets: the scene benchmark's table; quant
 import plot_sequence  # noqa: E402  (--table: the sequence summary's table)
 
 quantile = plot_scenes.quantile  # the tools' quantile (core/metrics.h): index floor(q n)
-SECTIONS = ("real_pairs", "scenes", "sequences", "sweeps", "rate")
+SECTIONS = ("real_pairs", "scenes", "sequences", "sweeps", "covariance", "rate")
 
 
 def read_rows(path):
@@ -609,6 +609,116 @@ def rate(out):
             m["load"].group(1) if m["load"] else "?",
             (m["simd"].group(1) or m["simd"].group(2)) if m["simd"] else "?"))
     print()
+
+
+# --- covariance --------------------------------------------------------------------------------
+
+CHAIN_AXES = ("x", "y", "z", "roll", "pitch", "yaw")
+
+
+def chain_consistency_table(rows):
+    """Per world (pooled over seeds, "small" and "drift" odometry, weighted by keyframes) and
+    over all: within 1 sd and beyond 3 sd per axis, and the mean NEES."""
+    rows = [r for r in rows if r["odometry"] in ("small", "drift")]
+    worlds = []
+    for r in rows:
+        w = r["label"].rsplit("_", 1)[0]
+        if w not in worlds:
+            worlds.append(w)
+    print("| world | runs | keyframes | within 1 sd [%%] %s | beyond 3 sd [%%] %s | NEES |"
+          % (" ".join(CHAIN_AXES), " ".join(CHAIN_AXES)))
+    print("|---|---|---|---|---|---|")
+
+    def line(name, group):
+        n = sum(int(r["keyframes"]) for r in group)
+        if not n:
+            return
+        share = lambda key, a: sum(float(r[key + a]) * int(r["keyframes"]) for r in group) / n
+        w1 = " ".join("%.0f" % (100 * share("within1_", a)) for a in CHAIN_AXES)
+        b3 = " ".join("%.1f" % (100 * share("beyond3_", a)) for a in CHAIN_AXES)
+        nees = sum(float(r["nees_mean"]) * int(r["keyframes"]) for r in group) / n
+        print("| %s | %d | %d | %s | %s | %.1f |" % (name, len(group), n, w1, b3, nees))
+
+    for w in worlds:
+        line(w, [r for r in rows if r["label"].rsplit("_", 1)[0] == w])
+    line("**all**", rows)
+    print()
+
+
+def anchored_table(rows):
+    """Per odometry mode: the chain, the chain tied to the odometry and the odometry alone,
+    medians over the runs of the largest position error (no alignment) and of RPE per 10 m."""
+    print("| odometry | runs | row | max position error [m], median (range) | RPE10 [%] median |")
+    print("|---|---|---|---|---|")
+    for odo in ("drift", "dgps"):
+        for method in ("cubes", "cubes-anchored", "odometry"):
+            group = [r for r in rows if r["odometry"] == odo and r["method"] == method]
+            if not group:
+                continue
+            err = [float(r["max_error_m"]) for r in group]
+            rpe = [float(r["rpe10_pct"]) for r in group if r["rpe10_pct"]]
+            print("| %s | %d | %s | %.2f (%s) | %s |" % (
+                odo, len(group), method, statistics.median(err), span(err, "%.2f"),
+                "%.2f" % statistics.median(rpe) if rpe else "-"))
+    print()
+
+
+def unseen_table(path):
+    """A single registration's calibration per scene: accepted right results (success) with a
+    covariance, the share beyond 3 predicted sd per axis and on the worst axis."""
+    rows = read_rows(path)
+    scenes = []
+    for r in rows:
+        if r["scene"] not in scenes:
+            scenes.append(r["scene"])
+    err = ("ex_m", "ey_m", "ez_m", "erx_rad", "ery_rad", "erz_rad")
+    sig = ("sx_m", "sy_m", "sz_m", "srx_rad", "sry_rad", "srz_rad")
+    print("| scene | accepted right | beyond 3 sd [%%] %s | worst axis beyond 3 sd [%%] |"
+          % " ".join(CHAIN_AXES))
+    print("|---|---|---|---|")
+    total = [0, [0] * 6, 0]
+    for scene in scenes:
+        n, per_axis, worst = 0, [0] * 6, 0
+        for r in rows:
+            if r["scene"] != scene or r["gate"] != "accepted" or r["success"] != "1":
+                continue
+            s = [float(r[k]) for k in sig]
+            if min(s) <= 0.0:
+                continue
+            z = [abs(float(r[e])) / sd for e, sd in zip(err, s)]
+            n += 1
+            for k in range(6):
+                per_axis[k] += z[k] > 3.0
+            worst += max(z) > 3.0
+        total[0] += n
+        total[1] = [a + b for a, b in zip(total[1], per_axis)]
+        total[2] += worst
+        if n:
+            print("| %s | %d | %s | %.1f |" % (scene, n, " ".join(
+                "%.1f" % (100.0 * v / n) for v in per_axis), 100.0 * worst / n))
+    if total[0]:
+        print("| **all** | %d | %s | %.1f |" % (total[0], " ".join(
+            "%.1f" % (100.0 * v / total[0]) for v in total[1]), 100.0 * total[2] / total[0]))
+    print()
+
+
+def covariance(out):
+    folder = os.path.join(out, "covariance")
+    consistency = os.path.join(folder, "chain_consistency.csv")
+    summary = os.path.join(folder, "chain_summary.csv")
+    unseen = os.path.join(folder, "scenes_unseen.csv")
+    if not any(os.path.exists(p) for p in (consistency, summary, unseen)):
+        missing(folder)
+        return
+    if os.path.exists(consistency):
+        print("### Covariance along the chain (chain_consistency.csv)\n")
+        chain_consistency_table(read_rows(consistency))
+    if os.path.exists(summary):
+        print("### The chain tied to the odometry (chain_summary.csv)\n")
+        anchored_table(read_rows(summary))
+    if os.path.exists(unseen):
+        print("### A single registration's covariance on unseen worlds (scenes_unseen.csv)\n")
+        unseen_table(unseen)
 
 
 def header(out, section):

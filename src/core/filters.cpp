@@ -53,6 +53,33 @@ PointArray filterPoints(const PointArray& in, const RangeFilterSettings& setting
   return out;
 }
 
+std::vector<std::uint32_t> keptIndices(const PointArray& in, const std::vector<float>& times,
+                                       const RangeFilterSettings& settings, FilterStats* stats) {
+  if (!times.empty() && times.size() != in.size()) {
+    throw std::invalid_argument("keptIndices: " + std::to_string(times.size()) + " times for " +
+                                std::to_string(in.size()) + " points");
+  }
+  std::vector<std::uint32_t> kept;
+  kept.reserve(in.size());
+  FilterStats st;
+  st.input = in.size();
+  PointArray one_out;
+  for (std::size_t i = 0; i < in.size(); ++i) {
+    if (!times.empty() && !std::isfinite(times[i])) {
+      ++st.non_finite;
+      continue;
+    }
+    one_out.clear();
+    const FilterStats one = appendFiltered(&in.x[i], &in.y[i], &in.z[i], 1, 1, settings, one_out);
+    st.non_finite += one.non_finite;
+    st.out_of_range += one.out_of_range;
+    if (!one_out.empty()) kept.push_back(std::uint32_t(i));
+  }
+  st.kept = kept.size();
+  if (stats) *stats = st;
+  return kept;
+}
+
 PointArray filterPoints(const PointArray& in, const std::vector<float>& times,
                         const RangeFilterSettings& settings, std::vector<float>& times_out,
                         FilterStats* stats) {

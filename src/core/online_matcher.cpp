@@ -216,6 +216,7 @@ OnlineStep OnlineMatcher::process(const PointArray& points, double stamp,
   const bool refused = !placeScan(step, keyframe, predicted.pose);
   countRejections(step, keyframe);
   updateChain(step, deskewed ? *deskewed : points, stamp, odom, keyframe, refused);
+  if (deskewed) step.deskewed_points = std::move(*deskewed);
   describe(step);
   return step;
 }

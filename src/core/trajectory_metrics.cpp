@@ -4,6 +4,8 @@
 #include <cmath>
 #include <stdexcept>
 
+#include <Eigen/Cholesky>
+
 #include "cube_scan_matcher/core/pose.h"
 
 namespace cube_scan_matcher {
@@ -89,6 +91,43 @@ StationaryDrift stationaryDrift(const Trajectory& truth, const Trajectory& estim
     i = j;
   }
   return s;
+}
+
+CovarianceConsistency covarianceConsistency(const Trajectory& truth, const Trajectory& estimate,
+                                            const std::vector<Eigen::Matrix<double, 6, 6>>& covariances,
+                                            const std::vector<bool>& use) {
+  if (truth.size() != estimate.size() || covariances.size() != truth.size() ||
+      (!use.empty() && use.size() != truth.size())) {
+    throw std::invalid_argument("covarianceConsistency: truth, estimate, covariances and use differ in size");
+  }
+  CovarianceConsistency out;
+  std::vector<double> nees;
+  for (std::size_t k = 0; k < truth.size(); ++k) {
+    if (!use.empty() && !use[k]) continue;
+    const Eigen::Matrix<double, 6, 6>& C = covariances[k];
+    const Eigen::LLT<Eigen::Matrix<double, 6, 6>> llt(C);
+    if (llt.info() != Eigen::Success) continue;
+    Eigen::Matrix<double, 6, 1> e;
+    e.head<3>() = estimate[k].translation() - truth[k].translation();
+    const Eigen::AngleAxisd d(estimate[k].linear() * truth[k].linear().transpose());
+    e.tail<3>() = d.axis() * d.angle();
+    for (int i = 0; i < 6; ++i) {
+      const double z = std::abs(e(i)) / std::sqrt(C(i, i));
+      out.within1(i) += z <= 1.0;
+      out.beyond3(i) += z > 3.0;
+    }
+    nees.push_back(e.dot(llt.solve(e)));
+  }
+  out.poses = int(nees.size());
+  if (out.poses == 0) return out;
+  out.within1 /= double(out.poses);
+  out.beyond3 /= double(out.poses);
+  double sum = 0.0;
+  for (double v : nees) sum += v;
+  out.nees_mean = sum / double(out.poses);
+  std::nth_element(nees.begin(), nees.begin() + std::ptrdiff_t(nees.size() / 2), nees.end());
+  out.nees_median = nees[nees.size() / 2];
+  return out;
 }
 
 }  // namespace cube_scan_matcher

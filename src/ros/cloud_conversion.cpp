@@ -74,7 +74,7 @@ PointArray fromCloud(const sensor_msgs::PointCloud2& cloud, const Eigen::Isometr
   return out;
 }
 
-std::vector<float> readTimes(const sensor_msgs::PointCloud2& cloud, const std::string& name) {
+std::vector<float> readFloatField(const sensor_msgs::PointCloud2& cloud, const std::string& name) {
   const sensor_msgs::PointField* f = findField(cloud, name);
   if (!f) return {};
   const std::uint8_t type = f->datatype;
@@ -105,11 +105,23 @@ std::vector<float> readTimes(const sensor_msgs::PointCloud2& cloud, const std::s
 }
 
 sensor_msgs::PointCloud2 toCloud(const PointArray& points, const Eigen::Isometry3d& transform,
-                                 const std_msgs::Header& header) {
+                                 const std_msgs::Header& header,
+                                 const std::vector<float>* intensity) {
+  if (intensity && intensity->size() != points.size()) {
+    throw std::invalid_argument("toCloud: " + std::to_string(intensity->size()) +
+                                " intensities for " + std::to_string(points.size()) + " points");
+  }
   sensor_msgs::PointCloud2 cloud;
   cloud.header = header;
   sensor_msgs::PointCloud2Modifier modifier(cloud);
-  modifier.setPointCloud2FieldsByString(1, "xyz");
+  if (intensity) {
+    modifier.setPointCloud2Fields(4, "x", 1, sensor_msgs::PointField::FLOAT32, "y", 1,
+                                  sensor_msgs::PointField::FLOAT32, "z", 1,
+                                  sensor_msgs::PointField::FLOAT32, "intensity", 1,
+                                  sensor_msgs::PointField::FLOAT32);
+  } else {
+    modifier.setPointCloud2FieldsByString(1, "xyz");
+  }
   modifier.resize(points.size());
   cloud.height = 1;
   cloud.width = std::uint32_t(points.size());
@@ -125,6 +137,10 @@ sensor_msgs::PointCloud2 toCloud(const PointArray& points, const Eigen::Isometry
     *x = v.x();
     *y = v.y();
     *z = v.z();
+  }
+  if (intensity) {
+    sensor_msgs::PointCloud2Iterator<float> in(cloud, "intensity");
+    for (std::size_t i = 0; i < points.size(); ++i, ++in) *in = (*intensity)[i];
   }
   return cloud;
 }

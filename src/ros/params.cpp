@@ -169,7 +169,22 @@ NodeParams loadParams(const ros::NodeHandle& pnh) {
     throw ParamError("parameter ~missing_tf_policy = '" + policy + "' must be identity or skip");
   }
   p.skip_without_tf = policy == "skip";
-  p.publish_tf = getBool(pnh, "publish_tf", p.publish_tf);
+  if (pnh.hasParam("publish_tf")) {
+    throw ParamError(
+        "parameter ~publish_tf is not read: set ~role to messages (no tf), map_odom (map -> odom "
+        "from the registration chain) or anchored (map -> odom tied to the odometry)");
+  }
+  const std::string role = getString(pnh, "role", "messages");
+  if (role == "messages") p.role = NodeParams::Role::Messages;
+  else if (role == "map_odom") p.role = NodeParams::Role::MapOdom;
+  else if (role == "anchored") p.role = NodeParams::Role::Anchored;
+  else throw ParamError("parameter ~role = '" + role + "' must be messages, map_odom or anchored");
+  p.reset_continuous = getBool(pnh, "reset_continuous", p.reset_continuous);
+  p.anchor.odometry_sigma_m = readParam(pnh, "odometry_sigma_translation",
+                                        p.anchor.odometry_sigma_m, 1e-3, 1e3, "m");
+  p.anchor.odometry_sigma_rad = deg2rad(readParam(pnh, "odometry_sigma_rotation",
+                                                  rad2deg(p.anchor.odometry_sigma_rad), 1e-3,
+                                                  180.0, "deg"));
   p.transform_tolerance =
       readParam(pnh, "transform_tolerance", p.transform_tolerance, 0.0, 10.0, "s");
   p.tf_rate = readParam(pnh, "tf_rate", p.tf_rate, 0.1, 1000.0, "Hz");
@@ -184,9 +199,23 @@ NodeParams loadParams(const ros::NodeHandle& pnh) {
   if (pnh.hasParam("time_field") && !pnh.getParam("time_field", p.time_field)) {
     throw ParamError("parameter ~time_field must be a string (empty = no point times)");
   }
-  p.sigma_translation = readParam(pnh, "sigma_translation", p.sigma_translation, 1e-6, 100.0, "m");
-  p.sigma_rotation = readParam(pnh, "sigma_rotation", p.sigma_rotation, 1e-6, 180.0, "deg");
-  p.rejected_sigma_scale = readParam(pnh, "rejected_sigma_scale", p.rejected_sigma_scale, 1.0, 1e6);
+  p.chain.sigma_m = readParam(pnh, "sigma_translation", p.chain.sigma_m, 1e-6, 100.0, "m");
+  p.chain.sigma_rad =
+      deg2rad(readParam(pnh, "sigma_rotation", rad2deg(p.chain.sigma_rad), 1e-6, 180.0, "deg"));
+  if (pnh.hasParam("rejected_sigma_scale")) {
+    throw ParamError(
+        "parameter ~rejected_sigma_scale is not read: set ~rejected_sigma_translation [m] and "
+        "~rejected_sigma_rotation [deg], the odometry's error over one increment");
+  }
+  p.chain.registration_scale = readParam(pnh, "registration_sigma_scale",
+                                         p.chain.registration_scale, 1e-3, 1.0);
+  p.chain.drift_fraction =
+      readParam(pnh, "drift_percent", 100.0 * p.chain.drift_fraction, 0.0, 100.0, "%") / 100.0;
+  p.chain.rejected_sigma_m = readParam(pnh, "rejected_sigma_translation", p.chain.rejected_sigma_m,
+                                       1e-6, 100.0, "m");
+  p.chain.rejected_sigma_rad =
+      deg2rad(readParam(pnh, "rejected_sigma_rotation", rad2deg(p.chain.rejected_sigma_rad), 1e-6,
+                        180.0, "deg"));
   p.min_rate = readParam(pnh, "min_rate", p.min_rate, 0.0, 1000.0, "Hz");
   p.max_rate = readParam(pnh, "max_rate", p.max_rate, 0.0, 1e6, "Hz");
   if (p.max_rate <= p.min_rate) throw ParamError("parameter ~max_rate must exceed ~min_rate");

@@ -78,6 +78,8 @@ void ScanMatcherNodelet::onInit() {
     return;
   }
   matcher_ = std::make_unique<OnlineMatcher>(params_.matcher);
+  chain_ = std::make_unique<ChainCovariance>(params_.chain);
+  anchor_ = std::make_unique<OdometryAnchor>(params_.anchor);
 
   min_rate_ = params_.min_rate;
   max_rate_ = params_.max_rate;
@@ -87,7 +89,7 @@ void ScanMatcherNodelet::onInit() {
 
   tf_buffer_ = std::make_unique<tf2_ros::Buffer>(ros::Duration(60.0));
   tf_listener_ = std::make_unique<tf2_ros::TransformListener>(*tf_buffer_, nh);
-  if (params_.publish_tf) {
+  if (params_.publishesTf()) {
     tf_broadcaster_ = std::make_unique<tf2_ros::TransformBroadcaster>();
     // On the manager's multi-threaded queue: a registration (seconds for a de-skewed sweep)
     // must not hold map -> odom back (sendMapOdom takes tf_mutex_ only).
@@ -141,9 +143,17 @@ void ScanMatcherNodelet::reconfigure(ScanMatcherConfig& config, uint32_t /*level
 
 bool ScanMatcherNodelet::resetService(std_srvs::Trigger::Request&, std_srvs::Trigger::Response& res) {
   std::lock_guard<std::mutex> lock(mutex_);
+  // Continuous: the new chain starts where the old one was, moved on by the odometry from the
+  // last published scan to the next one, so that map does not jump.
+  const std::optional<Eigen::Isometry3d> last_pose = last_pose_, last_odom = last_odom_;
   resetState("reset requested through the ~reset service");
   res.success = true;
   res.message = "reference, pose chain, path and counters reset";
+  if (params_.reset_continuous && last_pose) {
+    matcher_->restartAt(*last_pose);
+    pending_start_ = PendingStart{*last_pose, last_odom};
+    res.message += "; the new chain continues from the last pose";
+  }
   return true;
 }
 
@@ -197,11 +207,23 @@ std::string ScanMatcherNodelet::restartChain(const geometry_msgs::PoseWithCovari
   if (!t.allFinite() || !q.coeffs().allFinite() || std::abs(q.norm() - 1.0) > 1e-3) {
     return "pose must be finite with a unit quaternion";
   }
-  resetState("pose set through " + source);
   Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();
   pose.linear() = q.normalized().toRotationMatrix();
   pose.translation() = t;
+  // The pose holds at the request's stamp: the next scan's start is moved on by the odometry
+  // from that stamp to its own (a zero stamp: the pose holds at the next scan).
+  std::optional<Eigen::Isometry3d> odom_at_stamp;
+  if (!req.header.stamp.isZero()) {
+    std::string error;
+    odom_at_stamp = lookup(params_.odom_frame, params_.base_frame, req.header.stamp, error);
+    if (!odom_at_stamp) {
+      return "no odometry at the pose's stamp " + std::to_string(req.header.stamp.toSec()) +
+             " s (" + error + "); send it with a zero stamp to start the next scan there";
+    }
+  }
+  resetState("pose set through " + source);
   matcher_->restartAt(pose);
+  pending_start_ = PendingStart{pose, odom_at_stamp};
   // The request's covariance; a variance it leaves at 0 (unknown) becomes the configured one.
   const auto& c = req.pose.covariance;
   Matrix6d start = Matrix6d::Zero();
@@ -209,11 +231,12 @@ std::string ScanMatcherNodelet::restartChain(const geometry_msgs::PoseWithCovari
     for (int j = 0; j < 6; ++j) start(i, j) = c[std::size_t(6 * i + j)];
   }
   start = 0.5 * (start + start.transpose());
-  const Matrix6d floors = diagonalCovariance(params_.sigma_translation, deg2rad(params_.sigma_rotation));
+  const Matrix6d floors = diagonalCovariance(chain_->settings().sigma_m, chain_->settings().sigma_rad);
   for (int i = 0; i < 6; ++i) {
     if (!(start(i, i) > 0.0)) start(i, i) = floors(i, i);
   }
-  start_cov_ = start;
+  chain_->restart(start);
+  anchor_->reset(start);
   return "";
 }
 
@@ -225,7 +248,10 @@ void ScanMatcherNodelet::resetState(const std::string& why) {
   last_stamp_.reset();
   dropped_ = rejected_ = tf_failures_ = processed_ = bad_input_ = consecutive_rejections_ = 0;
   latencies_.clear();
-  start_cov_.reset();
+  if (chain_) chain_->restart(std::nullopt);
+  if (anchor_) anchor_->reset(std::nullopt);
+  pending_start_.reset();
+  last_odom_.reset();
   last_twist_.reset();
   last_pose_.reset();
 }
@@ -376,15 +402,24 @@ bool ScanMatcherNodelet::convertPoints(Scan& scan) {
   try {
     const PointArray all = fromCloud(scan.msg, scan.T_base_cloud);
     const std::vector<float> tau =
-        params_.time_field.empty() ? std::vector<float>{} : readTimes(scan.msg, params_.time_field);
-    if (tau.empty()) {
-      scan.points = filterPoints(all, params_.filter, &fs);
-    } else {
+        params_.time_field.empty() ? std::vector<float>{} : readFloatField(scan.msg, params_.time_field);
+    const std::vector<float> intensity = readFloatField(scan.msg, "intensity");
+    // The points kept, and with them their times and intensities.
+    const std::vector<std::uint32_t> kept = keptIndices(all, tau, params_.filter, &fs);
+    auto gather = [&kept](const std::vector<float>& v, std::vector<float>& out) {
+      out.resize(kept.size());
+      for (std::size_t i = 0; i < kept.size(); ++i) out[i] = v[kept[i]];
+    };
+    gather(all.x, scan.points.x);
+    gather(all.y, scan.points.y);
+    gather(all.z, scan.points.z);
+    if (!intensity.empty()) gather(intensity, scan.intensity.emplace());
+    if (!tau.empty()) {
       // A sweep taken over time: a cloud in the odometry frame was placed by tf (the
       // odometry) line by line; one in another frame is taken as rigid (core/deskew.h).
       PointTimes times;
       times.placed_by_odometry = scan.msg.header.frame_id == params_.odom_frame;
-      scan.points = filterPoints(all, tau, params_.filter, times.tau, &fs);
+      gather(tau, times.tau);
       scan.times = std::move(times);
     }
   } catch (const CloudError& e) {
@@ -403,6 +438,14 @@ bool ScanMatcherNodelet::convertPoints(Scan& scan) {
 }
 
 OnlineStep ScanMatcherNodelet::registerScan(Scan& scan) {
+  // A chain started by ~set_pose, initialpose or a continuous ~reset: its pose, moved on by the
+  // odometry from when it held to this scan.
+  if (pending_start_) {
+    if (pending_start_->odom && scan.odom) {
+      matcher_->restartAt(pending_start_->pose * pending_start_->odom->inverse() * *scan.odom);
+    }
+    pending_start_.reset();
+  }
   // Register, gate and chain (core).
   const OnlineStep step =
       matcher_->process(scan.points, scan.msg.header.stamp.toSec(), scan.odom,
@@ -456,40 +499,26 @@ OnlineStep ScanMatcherNodelet::registerScan(Scan& scan) {
 }
 
 void ScanMatcherNodelet::publishPose(const Scan& scan, const OnlineStep& step) {
-  // Covariance along the chain of keyframes: a scan's pose is its keyframe's times one
-  // increment (compoundCovariance: the keyframe's rotation error moves the pose through the
-  // lever arm of the increment). An accepted increment carries the registration's covariance
-  // (the polish's, rotated from the keyframe's axes into the map's) with the configured sigmas
-  // as a floor; one propagated by odometry carries (rejected_sigma_scale * sigma)^2. A new
-  // keyframe keeps its covariance; a chain starts at sigma^2 (or the ~set_pose covariance).
-  // Standing still (no new keyframe) the covariance does not grow.
-  const double st = params_.sigma_translation, sr = deg2rad(params_.sigma_rotation);
-  const Eigen::Isometry3d keyframe = step.pose * step.increment.inverse();  // T_map_keyframe
-  const Eigen::Vector3d lever_arm = step.pose.translation() - keyframe.translation();
-  // The registration's covariance in the keyframe's axes, floored (used when accepted).
-  const Matrix6d registered = floorCovariance(step.result.covariance, st, sr);
-  Matrix6d cov;
-  if (step.reason == GateReason::FirstScan) {
-    cov = start_cov_ ? *start_cov_ : diagonalCovariance(st, sr);
-    start_cov_.reset();
-  } else if (step.accepted) {
-    cov = compoundCovariance(keyframe_cov_, rotateCovariance(registered, keyframe.linear()),
-                             lever_arm);
-  } else {
-    const double scale = params_.rejected_sigma_scale;
-    cov = compoundCovariance(keyframe_cov_, diagonalCovariance(scale * st, scale * sr), lever_arm);
+  // Covariance along the chain of keyframes (chain_covariance.h); with the anchored role the
+  // published pose is the chain tied to the odometry (odometry_anchor.h), with its covariance.
+  const StepCovariance cov = chain_->add(step);
+  Eigen::Isometry3d published = step.pose;
+  Matrix6d published_cov = cov.pose;
+  if (params_.role == NodeParams::Role::Anchored) {
+    published = anchor_->add(step.pose, cov.motion, scan.odom);
+    published_cov = anchor_->covariance();
   }
-  if (step.reference_updated) keyframe_cov_ = cov;
   std_msgs::Header header;
   header.stamp = scan.msg.header.stamp;
   header.frame_id = params_.map_frame;
 
   geometry_msgs::PoseWithCovarianceStamped pose;
   pose.header = header;
-  pose.pose.pose = toPoseMsg(step.pose);
-  pose.pose.covariance = toMsg(cov);
+  pose.pose.pose = toPoseMsg(published);
+  pose.pose.covariance = toMsg(published_cov);
   pose_pub_.publish(pose);
-  last_pose_ = step.pose;
+  last_pose_ = published;
+  last_odom_ = scan.odom;
 
   nav_msgs::Odometry odometry;
   odometry.header = header;
@@ -507,7 +536,7 @@ void ScanMatcherNodelet::publishPose(const Scan& scan, const OnlineStep& step) {
         aa.axis() * aa.angle() / step.interval;
     odometry.twist.twist = toTwistMsg(twist);
     odometry.twist.covariance = toMsg(twistCovariance(
-        rotateCovariance(registered, step.increment.linear().transpose()),  // base_frame axes
+        rotateCovariance(cov.increment, step.increment.linear().transpose()),  // base_frame axes
         step.interval, twist - last_twist_.value_or(Vector6d::Zero())));
     last_twist_ = twist;
   }
@@ -524,12 +553,17 @@ void ScanMatcherNodelet::publishPose(const Scan& scan, const OnlineStep& step) {
   }
   path_pub_.publish(path_);
 
-  if (cloud_pub_.getNumSubscribers() > 0) cloud_pub_.publish(toCloud(scan.points, step.pose, header));
+  if (cloud_pub_.getNumSubscribers() > 0) {
+    // The sweep as registered: re-placed with the registered motion when it was de-skewed.
+    const PointArray& points = step.deskewed ? step.deskewed_points : scan.points;
+    cloud_pub_.publish(
+        toCloud(points, published, header, scan.intensity ? &*scan.intensity : nullptr));
+  }
 
   if (tf_broadcaster_ && scan.odom) {
     // REP-105: map -> odom such that map -> odom -> base_link equals the registered pose.
     bool first;
-    const Eigen::Isometry3d map_odom = step.pose * scan.odom->inverse();
+    const Eigen::Isometry3d map_odom = published * scan.odom->inverse();
     {
       std::lock_guard<std::mutex> lock(tf_mutex_);
       first = !map_odom_;

@@ -141,7 +141,8 @@ OdometryError odometryErrorFromString(const std::string& name) {
   if (name == "small") return OdometryError::Small;
   if (name == "big") return OdometryError::Big;
   if (name == "drift") return OdometryError::Drift;
-  throw std::invalid_argument("odometry error mode must be none, small, big or drift, got '" +
+  if (name == "dgps") return OdometryError::Dgps;
+  throw std::invalid_argument("odometry error mode must be none, small, big, drift or dgps, got '" +
                               name + "'");
 }
 
@@ -160,6 +161,16 @@ Eigen::Isometry3d OdometrySimulator::next(const Eigen::Isometry3d& truth) {
         bias_ = bias_ * randomTransform(rng_, 0.05, 0.3);
         odom = truth * bias_;
         break;
+      case OdometryError::Dgps: {
+        // o_k = a o_(k-1) + sqrt(1 - a^2) sd n_k keeps the offset's sd at `sd` once stationary.
+        const double a = std::exp(-1.0 / 20.0), b = std::sqrt(1.0 - a * a);
+        const double sd[6] = {0.3, 0.3, 0.3, deg2rad(0.2), deg2rad(0.2), deg2rad(0.5)};
+        std::normal_distribution<double> n(0.0, 1.0);
+        for (int i = 0; i < 6; ++i) offset_(i) = a * offset_(i) + b * sd[i] * n(rng_);
+        odom.translation() = truth.translation() + offset_.head<3>();
+        odom.linear() = rotationFromRpy(offset_(3), offset_(4), offset_(5)) * truth.linear();
+        break;
+      }
     }
   }
   first_ = false;

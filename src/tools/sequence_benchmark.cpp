@@ -4,6 +4,7 @@
 //   sequence_benchmark --dir ../shared/data/balm_os0_hall_seq_a --odometry big   (real + poses.tum)
 // Metrics: relative pose error per 10/50/100 m (% and deg/m), ATE after a rigid alignment,
 // drift while standing still, accepted / rejected scans, median time per scan.
+#include <algorithm>
 #include <chrono>
 #include <cstdio>
 #include <functional>
@@ -14,7 +15,9 @@
 #include <string>
 #include <vector>
 
+#include "cube_scan_matcher/core/chain_covariance.h"
 #include "cube_scan_matcher/core/metrics.h"
+#include "cube_scan_matcher/core/odometry_anchor.h"
 #include "cube_scan_matcher/core/online_matcher.h"
 #include "cube_scan_matcher/core/trajectory_metrics.h"
 #include "cube_scan_matcher/io/cloud_io.h"
@@ -40,8 +43,8 @@ void usage(std::ostream& os) {
         "  --world-seed N        world, trajectory and noise seed (default 1; --seed is the\n"
         "                        GNMM's)\n"
         "  --dir DIR             real sequence: DIR/*.pcd|*.ply in name order + DIR/poses.tum\n"
-        "  --odometry MODE       none, small, big, drift: odometry = truth with the simulator's\n"
-        "                        errors per increment (motion.h); cv: no odometry, constant\n"
+        "  --odometry MODE       none, small, big, drift, dgps: odometry = truth with the\n"
+        "                        simulator's errors (motion.h); cv: no odometry, constant\n"
         "                        velocity from each method's own estimate; identity: no\n"
         "                        odometry, no motion (default big)\n"
         "  --period S            simulated time between sweeps [s] (default 1.5)\n"
@@ -60,6 +63,18 @@ void usage(std::ostream& os) {
 
         "  --voxel L             peers' voxel leaf [m] (default 0.2)\n"
         "  --csv FILE            per-scan trajectories (default sequence.csv)\n"
+        "  --chain-sigmas LIST   comma list of chain covariance settings (chain_covariance.h)\n"
+        "                        M:DEG:PCT:SCALE: floors of an accepted increment [m, deg], the\n"
+        "                        scale error's sd [%], the factor on the registration's sd;\n"
+        "                        default the package's. Each is checked against the truth at\n"
+        "                        the cube methods' keyframes\n"
+        "  --anchor-sigma-m M, --anchor-sigma-deg D   the odometry's absolute sd assumed by the\n"
+        "                        anchored rows (odometry_anchor.h; default 0.5 m, 2 deg). With\n"
+        "                        odometry, each cube method also gets a row NAME-anchored (its\n"
+        "                        chain tied to the odometry) and the table a row \"odometry\"\n"
+        "  --consistency FILE    one line per cube method and chain setting appended: shares\n"
+        "                        of keyframe errors within 1 and beyond 3 predicted sd per\n"
+        "                        axis, and the NEES (default: none)\n"
         "  --summary FILE        one line per method appended (default: none)\n"
         "  --label TEXT          run label in the CSVs (default: scene or folder name)\n"
         "  --check-pct P, --check-deg-m D, --check-still-m S, --check-rejected N\n"
@@ -78,6 +93,14 @@ struct Method {
   Trajectory poses;
   std::vector<double> times;
   int accepted = 0, rejected = 0;
+  /// Cube methods: per scan, whether it became a keyframe, and its pose's covariance along the
+  /// chain (chain_covariance.h) for each of the benchmark's chain settings.
+  std::vector<bool> keyframe;
+  std::vector<std::vector<Matrix6d>> covariances;
+  /// Cube methods with odometry: the chain tied to the odometry (odometry_anchor.h).
+  Trajectory anchored;
+  /// A row computed from the others (an anchored chain, the odometry): reported, not checked.
+  bool derived = false;
   /// Processes scan k; `odom` is the odometry (T_odom_base) when the mode has one.
   std::function<void(Method&, const PointArray&, double, const std::optional<Eigen::Isometry3d>&)> step;
 };
@@ -105,17 +128,29 @@ Eigen::Isometry3d lastMotion(const Trajectory& poses) {
 }
 
 Method cubeMethod(const std::string& name, const OnlineMatcherSettings& settings,
-                  const RangeFilterSettings& filter, bool constant_velocity) {
+                  const RangeFilterSettings& filter, bool constant_velocity,
+                  const std::vector<ChainCovarianceSettings>& chain_settings,
+                  const OdometryAnchorSettings& anchor_settings) {
   Method m;
   m.name = name;
   OnlineMatcherSettings s = settings;
   s.constant_velocity = constant_velocity;
   auto matcher = std::make_shared<OnlineMatcher>(s);
-  m.step = [matcher, filter](Method& self, const PointArray& points, double stamp,
-                             const std::optional<Eigen::Isometry3d>& odom) {
+  auto chains = std::make_shared<std::vector<ChainCovariance>>();
+  for (const ChainCovarianceSettings& c : chain_settings) chains->emplace_back(c);
+  m.covariances.resize(chain_settings.size());
+  auto anchor = std::make_shared<OdometryAnchor>(anchor_settings);
+  m.step = [matcher, chains, anchor, filter](Method& self, const PointArray& points, double stamp,
+                                             const std::optional<Eigen::Isometry3d>& odom) {
     const auto t0 = std::chrono::steady_clock::now();
     const OnlineStep st = matcher->process(filterPoints(points, filter), stamp, odom);
     self.times.push_back(std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
+    self.keyframe.push_back(st.reference_updated);
+    for (std::size_t i = 0; i < chains->size(); ++i) {
+      const StepCovariance c = (*chains)[i].add(st);
+      self.covariances[i].push_back(c.pose);
+      if (i == 0 && odom) self.anchored.push_back(anchor->add(st.pose, c.motion, odom));
+    }
     if (st.registered) (st.accepted ? self.accepted : self.rejected)++;
     if (st.registered && !st.accepted) {
       std::fprintf(stderr, "%s scan %zu: %s\n", self.name.c_str(), self.poses.size(), st.message.c_str());
@@ -171,6 +206,48 @@ Method peerMethod(const std::string& name, PeerFn fn, double voxel, bool constan
   return m;
 }
 
+/// Each cube method's chain covariance against the truth at its keyframes (the chain's
+/// nodes; the first scan, exact by definition, left out), for each chain setting.
+void reportConsistency(const std::vector<Method>& table, const Trajectory& truth,
+                       const std::vector<ChainCovarianceSettings>& chain_settings,
+                       const std::string& label, const std::string& odometry_mode,
+                       std::uint64_t seed, const std::string& path) {
+  std::optional<CsvWriter> csv;
+  if (!path.empty()) {
+    csv.emplace(path,
+                "label,odometry,world_seed,method,sigma_m,sigma_deg,drift_pct,registration_scale,"
+                "keyframes,within1_x,"
+                "within1_y,within1_z,within1_roll,within1_pitch,within1_yaw,beyond3_x,beyond3_y,"
+                "beyond3_z,beyond3_roll,beyond3_pitch,beyond3_yaw,nees_mean,nees_median",
+                CsvWriter::Mode::Append);
+  }
+  std::printf("chain covariance at keyframes: %% within 1 sd | %% beyond 3 sd, x y z roll pitch yaw\n");
+  for (const Method& m : table) {
+    if (m.covariances.empty()) continue;
+    std::vector<bool> use = m.keyframe;
+    if (!use.empty()) use[0] = false;
+    for (std::size_t i = 0; i < chain_settings.size(); ++i) {
+      const CovarianceConsistency c = covarianceConsistency(truth, m.poses, m.covariances[i], use);
+      std::printf("%-14s %.3g m %.3g deg %.3g %% x%.2g: %d keyframes, within 1 sd",
+                  m.name.c_str(), chain_settings[i].sigma_m, rad2deg(chain_settings[i].sigma_rad),
+                  100.0 * chain_settings[i].drift_fraction, chain_settings[i].registration_scale,
+                  c.poses);
+      for (int a = 0; a < 6; ++a) std::printf(" %.0f", 100.0 * c.within1(a));
+      std::printf(", beyond 3 sd");
+      for (int a = 0; a < 6; ++a) std::printf(" %.1f", 100.0 * c.beyond3(a));
+      std::printf(", NEES mean %.2f median %.2f (6 if consistent)\n", c.nees_mean, c.nees_median);
+      if (!csv) continue;
+      *csv << label << odometry_mode << seed << m.name << chain_settings[i].sigma_m
+           << rad2deg(chain_settings[i].sigma_rad) << 100.0 * chain_settings[i].drift_fraction
+           << chain_settings[i].registration_scale << c.poses;
+      for (int a = 0; a < 6; ++a) *csv << c.within1(a);
+      for (int a = 0; a < 6; ++a) *csv << c.beyond3(a);
+      *csv << c.nees_mean << c.nees_median;
+      csv->endRow();
+    }
+  }
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -183,6 +260,9 @@ int main(int argc, char** argv) {
   std::vector<std::string> methods = {"cubes", "cubes-s2s", "gicp", "ndt"};
   OnlineMatcherSettings matcher_settings;
   RangeFilterSettings filter;
+  std::vector<ChainCovarianceSettings> chain_settings{ChainCovarianceSettings{}};
+  std::string consistency_path;
+  OdometryAnchorSettings anchor_settings;
   try {
     auto& gate = matcher_settings.gate;
     for (ArgReader r(argc, argv); r.more();) {
@@ -205,6 +285,37 @@ int main(int argc, char** argv) {
           r.option("--require-polish", gate.require_polish) ||
           r.option("--max-sigma", gate.max_sigma_m) || r.option("--csv", csv_path) ||
           r.option("--summary", summary_path) || r.option("--label", label) ||
+          r.optionWith("--chain-sigmas",
+                       [&](const std::string& v) {
+                         chain_settings.clear();
+                         for (const std::string& item : splitList(v)) {
+                           std::vector<double> v;
+                           std::size_t from = 0;
+                           for (std::size_t to; (to = item.find(':', from)) != std::string::npos;
+                                from = to + 1) {
+                             v.push_back(io::parseNumber("--chain-sigmas", item.substr(from, to - from)));
+                           }
+                           v.push_back(io::parseNumber("--chain-sigmas", item.substr(from)));
+                           if (v.size() != 4) {
+                             throw std::invalid_argument("--chain-sigmas: '" + item +
+                                                         "' is not M:DEG:PCT:SCALE");
+                           }
+                           ChainCovarianceSettings c;
+                           c.sigma_m = v[0];
+                           c.sigma_rad = deg2rad(v[1]);
+                           c.drift_fraction = v[2] / 100.0;
+                           c.registration_scale = v[3];
+                           validate(c);
+                           chain_settings.push_back(c);
+                         }
+                       }) ||
+          r.option("--consistency", consistency_path) ||
+          r.option("--anchor-sigma-m", anchor_settings.odometry_sigma_m) ||
+          r.optionWith("--anchor-sigma-deg",
+                       [&](const std::string& v) {
+                         anchor_settings.odometry_sigma_rad =
+                             deg2rad(io::parseNumber("--anchor-sigma-deg", v));
+                       }) ||
           r.option("--check-pct", check_pct) || r.option("--check-deg-m", check_deg_m) ||
           r.option("--check-still-m", check_still_m) ||
           r.option("--check-rejected", check_rejected))
@@ -225,14 +336,15 @@ int main(int argc, char** argv) {
     std::vector<Method> table;
     for (const std::string& m : methods) {
       OnlineMatcherSettings s = matcher_settings;
-      if (m == "cubes") table.push_back(cubeMethod(m, s, filter, !identity));
+      if (m == "cubes") table.push_back(cubeMethod(m, s, filter, !identity, chain_settings, anchor_settings));
       else if (m == "cubes-s2s") {
         s.keyframes.distance = 0.0, s.keyframes.angle = 0.0, s.keyframes.interval = 0.0;
         s.keyframes.submap_size = 1;
-        table.push_back(cubeMethod(m, s, filter, !identity));
+        table.push_back(cubeMethod(m, s, filter, !identity, chain_settings, anchor_settings));
       } else if (m == "cubes-submap") {
         s.keyframes.submap_size = submap;
-        table.push_back(cubeMethod(m + std::to_string(submap), s, filter, !identity));
+        table.push_back(cubeMethod(m + std::to_string(submap), s, filter, !identity, chain_settings,
+                                    anchor_settings));
       } else if (m == "gicp") table.push_back(peerMethod(m, runGicp, voxel, cv, matcher_settings.gate));
       else if (m == "ndt") table.push_back(peerMethod(m, runNdt, voxel, cv, matcher_settings.gate));
       else if (m == "icp") table.push_back(peerMethod(m, runIcp, voxel, cv, matcher_settings.gate));
@@ -262,7 +374,7 @@ int main(int argc, char** argv) {
     std::mt19937_64 rng(seed);
     const sim::ScannerModel model;
 
-    Trajectory truth;
+    Trajectory truth, odometry_poses;
     std::vector<double> distance;
     double travelled = 0.0;
     for (std::size_t k = 0;; ++k) {
@@ -286,8 +398,29 @@ int main(int argc, char** argv) {
       truth.push_back(pose);
       std::optional<Eigen::Isometry3d> odom;
       if (has_odometry) odom = odometry.next(pose);
+      if (odom) odometry_poses.push_back(*odom);
       for (Method& m : table) m.step(m, points, stamp, odom);
       if (k % 25 == 0) std::fprintf(stderr, "scan %zu, %.0f m\n", k, travelled);
+    }
+    // The odometry alone and each cube chain tied to it, as rows of their own.
+    if (has_odometry) {
+      const std::size_t methods_run = table.size();
+      for (std::size_t i = 0; i < methods_run; ++i) {
+        if (table[i].anchored.size() != truth.size()) continue;
+        Method a;
+        a.name = table[i].name + "-anchored";
+        a.poses = table[i].anchored;
+        a.times = table[i].times;
+        a.accepted = table[i].accepted, a.rejected = table[i].rejected;
+        a.derived = true;
+        table.push_back(std::move(a));
+      }
+      Method o;
+      o.name = "odometry";
+      o.poses = odometry_poses;
+      o.times.assign(truth.size(), 0.0);
+      o.derived = true;
+      table.push_back(std::move(o));
     }
 
     CsvWriter csv(csv_path,
@@ -306,7 +439,7 @@ int main(int argc, char** argv) {
       summary.emplace(summary_path,
                       "label,odometry,method,scans,length_m,accepted,rejected,rpe10_pct,"
                       "rpe10_deg_m,rpe50_pct,rpe50_deg_m,rpe100_pct,rpe100_deg_m,ate_m,"
-                      "still_scans,still_m,still_deg,median_time_s",
+                      "still_scans,still_m,still_deg,median_time_s,max_error_m",
                       CsvWriter::Mode::Append);
     }
     const StationaryDrift still_truth = stationaryDrift(truth, truth);
@@ -314,15 +447,21 @@ int main(int argc, char** argv) {
     std::printf("%s, odometry %s: %zu scans, %.1f m, %d standing-still runs (%d scans)\n",
                 label.c_str(), odometry_mode.c_str(), truth.size(), travelled,
                 still_truth.segments, still_truth.scans);
-    std::printf("%-14s %6s %6s %14s %14s %14s %8s %14s %9s\n", "method", "acc", "rej",
-                "RPE10 %|deg/m", "RPE50 %|deg/m", "RPE100 %|deg/m", "ATE m", "still m|deg",
-                "median s");
+    std::printf("%-16s %6s %6s %14s %14s %14s %8s %8s %14s %9s\n", "method", "acc", "rej",
+                "RPE10 %|deg/m", "RPE50 %|deg/m", "RPE100 %|deg/m", "ATE m", "max m",
+                "still m|deg", "median s");
     std::vector<std::string> failures;
     for (const Method& m : table) {
       RelativeError r[3];
       const double lengths[3] = {10.0, 50.0, 100.0};
       for (int i = 0; i < 3; ++i) r[i] = relativePoseError(truth, m.poses, lengths[i]);
       const double ate = absoluteTrajectoryError(truth, m.poses);
+      // The largest position error as published, without any alignment (map = world at the
+      // first scan): what the anchored rows bound.
+      double max_error = 0.0;
+      for (std::size_t k = 0; k < truth.size(); ++k) {
+        max_error = std::max(max_error, (m.poses[k].translation() - truth[k].translation()).norm());
+      }
       const StationaryDrift sd = stationaryDrift(truth, m.poses);
       const double t_med = quantile(m.times, 0.5);
       auto cell = [](const RelativeError& e) {
@@ -331,9 +470,9 @@ int main(int argc, char** argv) {
         else std::snprintf(b, sizeof b, "%.2f|%.4f", e.translation_pct, e.rotation_deg_per_m);
         return std::string(b);
       };
-      std::printf("%-14s %6d %6d %14s %14s %14s %8.3f %8.3f|%.2f %9.3f\n", m.name.c_str(),
+      std::printf("%-16s %6d %6d %14s %14s %14s %8.3f %8.3f %8.3f|%.2f %9.3f\n", m.name.c_str(),
                   m.accepted, m.rejected, cell(r[0]).c_str(), cell(r[1]).c_str(), cell(r[2]).c_str(),
-                  ate, sd.translation, sd.rotation_deg, t_med);
+                  ate, max_error, sd.translation, sd.rotation_deg, t_med);
       if (summary) {
         *summary << label << odometry_mode << m.name << truth.size() << travelled << m.accepted
                  << m.rejected;
@@ -341,10 +480,10 @@ int main(int argc, char** argv) {
           if (e.segments == 0) *summary << "" << "";
           else *summary << e.translation_pct << e.rotation_deg_per_m;
         }
-        *summary << ate << sd.scans << sd.translation << sd.rotation_deg << t_med;
+        *summary << ate << sd.scans << sd.translation << sd.rotation_deg << t_med << max_error;
         summary->endRow();
       }
-      if (m.name.rfind("cubes", 0) == 0) {
+      if (m.name.rfind("cubes", 0) == 0 && !m.derived) {
         const RelativeError* longest = nullptr;
         for (const RelativeError& e : r) {
           if (e.segments > 0) longest = &e;
@@ -378,6 +517,7 @@ int main(int argc, char** argv) {
         }
       }
     }
+    reportConsistency(table, truth, chain_settings, label, odometry_mode, seed, consistency_path);
     for (const std::string& f : failures) std::fprintf(stderr, "CHECK FAILED %s\n", f.c_str());
     if (!failures.empty()) return 2;
   } catch (const std::exception& e) {

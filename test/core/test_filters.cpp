@@ -2,7 +2,10 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdint>
 #include <limits>
+#include <stdexcept>
+#include <vector>
 
 #include "cube_scan_matcher/core/filters.h"
 
@@ -28,6 +31,17 @@ TEST(Filters, DropsNonFiniteAndOutOfRange) {
   EXPECT_EQ(st.out_of_range, 2u);
   EXPECT_EQ(st.kept, 2u);
   EXPECT_FLOAT_EQ(out.z[1], 50.f);
+  // The kept indices name the same points; with times, a point without a finite time goes too.
+  FilterStats kst;
+  EXPECT_EQ(keptIndices(in, {}, s, &kst), (std::vector<std::uint32_t>{0, 5}));
+  EXPECT_EQ(kst.kept, 2u);
+  EXPECT_EQ(kst.non_finite, 2u);
+  const std::vector<float> times{-0.1f, 0, 0, 0, 0, nan};
+  EXPECT_EQ(keptIndices(in, times, s, &kst), (std::vector<std::uint32_t>{0}));
+  EXPECT_EQ(kst.non_finite, 3u);
+  std::vector<float> times_out;
+  EXPECT_EQ(filterPoints(in, times, s, times_out).size(), 1u);
+  EXPECT_THROW(keptIndices(in, {0.0f}, s), std::invalid_argument);
 }
 
 TEST(Filters, RangeIsMeasuredFromTheOrigin) {

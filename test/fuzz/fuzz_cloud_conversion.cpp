@@ -41,7 +41,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   } catch (const cube_scan_matcher::CloudError&) {
   }
   try {
-    cube_scan_matcher::readTimes(msg, "time");  // the de-skew's per-point times
+    cube_scan_matcher::readFloatField(msg, "time");  // the de-skew's per-point times
   } catch (const cube_scan_matcher::CloudError&) {
   }
   return 0;

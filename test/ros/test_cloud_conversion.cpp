@@ -120,10 +120,10 @@ TEST(CloudConversion, PointTimesAreReadBesideThePointsAndFilteredWithThem) {
   const float nan = std::nanf("");
   const float xs[4] = {1, nan, 3, 4}, ts[4] = {-0.3f, -0.2f, nan, 0.0f};
   for (int i = 0; i < 4; ++i, ++x, ++y, ++z, ++t) *x = xs[i], *y = 0, *z = 0, *t = ts[i];
-  const std::vector<float> times = readTimes(c, "time");
+  const std::vector<float> times = readFloatField(c, "time");
   ASSERT_EQ(times.size(), 4u);
   EXPECT_FLOAT_EQ(times[0], -0.3f);
-  EXPECT_TRUE(readTimes(c, "t").empty());  // no such field: a rigid sweep
+  EXPECT_TRUE(readFloatField(c, "t").empty());  // no such field: a rigid sweep
   // A point without a position or without a time is dropped with its time.
   std::vector<float> kept;
   FilterStats st;
@@ -135,7 +135,7 @@ TEST(CloudConversion, PointTimesAreReadBesideThePointsAndFilteredWithThem) {
   // A time field of another type is named.
   c.fields[3].datatype = sensor_msgs::PointField::UINT32;
   try {
-    readTimes(c, "time");
+    readFloatField(c, "time");
     FAIL() << "no CloudError";
   } catch (const CloudError& e) {
     EXPECT_NE(std::string(e.what()).find("time"), std::string::npos) << e.what();

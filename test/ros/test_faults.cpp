@@ -504,6 +504,72 @@ TEST_F(Faults, SetPoseRestartsTheChainAtThePose) {
   EXPECT_GT(out.poseAt(stampOf(3))->pose.covariance[0], 0.04);
 }
 
+// ~set_pose with a stamp: the pose holds at that stamp, and the next scan's pose is it moved on
+// by the odometry from the stamp to the scan (a zero stamp: it holds at the next scan, above).
+TEST_F(Faults, SetPoseHonoursItsStamp) {
+  for (int k = 0; k < 2; ++k) sendSweep(k, stampOf(k));
+  Eigen::Isometry3d start = Eigen::Isometry3d::Identity();
+  start.translation() = Eigen::Vector3d(-20.0, 7.0, 1.0);
+  start.linear() = rotationFromRpy(0.0, 0.0, deg2rad(-35.0));
+  SetPose srv;
+  srv.request.pose.header.frame_id = "map";
+  srv.request.pose.header.stamp = stampOf(1);  // the odometry there is sweep 1's
+  srv.request.pose.pose.pose = tf2::toMsg(start);
+  ASSERT_TRUE(ros::service::call(kNs + "set_pose", srv));
+  EXPECT_TRUE(srv.response.success) << srv.response.message;
+  const Status s = sendSweep(2, stampOf(2));
+  EXPECT_EQ(s.reason, Status::FIRST_SCAN) << s.message;
+  ASSERT_TRUE(waitFor([&] { return out.poseAt(stampOf(2)) != nullptr; }, 5.0));
+  Eigen::Isometry3d p2;
+  tf2::fromMsg(out.poseAt(stampOf(2))->pose.pose, p2);
+  const Eigen::Isometry3d expected = start * drive.odom[1].inverse() * drive.odom[2];
+  EXPECT_LT((expected.inverse() * p2).translation().norm(), 1e-6);
+  EXPECT_LT(Eigen::AngleAxisd((expected.inverse() * p2).linear()).angle(), 1e-6);
+  // The robot moved between the stamps: holding the pose at the scan would be this far off.
+  EXPECT_GT((start.inverse() * p2).translation().norm(), 0.5);
+
+  // A stamp with no odometry on tf is refused, naming it, and the chain goes on.
+  srv.request.pose.header.stamp = stampOf(-1000);
+  ASSERT_TRUE(ros::service::call(kNs + "set_pose", srv));
+  EXPECT_FALSE(srv.response.success);
+  EXPECT_NE(srv.response.message.find("no odometry at the pose's stamp"), std::string::npos)
+      << srv.response.message;
+  EXPECT_EQ(sendSweep(3, stampOf(3)).reason, Status::ACCEPTED);
+}
+
+/// The matcher with reset_continuous (test/ros/faults.test).
+class FaultsContinuousReset : public Faults {
+ protected:
+  FaultsContinuousReset() : Faults("/scan_matcher_continuous/", "/test_cloud_continuous") {}
+};
+
+// ~reset with reset_continuous: the new chain starts at the last published pose moved on by the
+// odometry, so map does not jump to the odometry pose.
+TEST_F(FaultsContinuousReset, ResetKeepsTheMapContinuous) {
+  for (int k = 0; k < 4; ++k) {
+    const Status s = sendSweep(k, stampOf(k));
+    EXPECT_EQ(s.reason, k == 0 ? Status::FIRST_SCAN : Status::ACCEPTED) << s.message;
+  }
+  ASSERT_TRUE(waitFor([&] { return out.poseAt(stampOf(3)) != nullptr; }, 5.0));
+  Eigen::Isometry3d p3;
+  tf2::fromMsg(out.poseAt(stampOf(3))->pose.pose, p3);
+  std_srvs::Trigger reset;
+  ASSERT_TRUE(ros::service::call(ns + "reset", reset));
+  EXPECT_NE(reset.response.message.find("continues"), std::string::npos) << reset.response.message;
+  const Status s = sendSweep(4, stampOf(4));
+  EXPECT_EQ(s.reason, Status::FIRST_SCAN) << s.message;
+  ASSERT_TRUE(waitFor([&] { return out.poseAt(stampOf(4)) != nullptr; }, 5.0));
+  Eigen::Isometry3d p4;
+  tf2::fromMsg(out.poseAt(stampOf(4))->pose.pose, p4);
+  const Eigen::Isometry3d expected = p3 * drive.odom[3].inverse() * drive.odom[4];
+  EXPECT_LT((expected.inverse() * p4).translation().norm(), 1e-6);
+  // The odometry's errors since the chain's start put its own pose elsewhere: a reset that
+  // starts there would jump by this much.
+  EXPECT_GT((drive.odom[4].inverse() * p4).translation().norm(), 0.02);
+  // The chain goes on from there.
+  EXPECT_EQ(sendSweep(5, stampOf(5)).reason, Status::ACCEPTED);
+}
+
 // The demo's evaluator (SweepEvaluator) goes on past a sweep the matcher never answered: the
 // sweep is listed as dropped and the next increment is measured from the last answered one.
 TEST(SweepEvaluatorAcrossDrops, ADroppedSweepDoesNotStopTheRows) {

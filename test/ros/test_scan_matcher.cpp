@@ -7,6 +7,7 @@
 
 #include <cmath>
 #include <limits>
+#include <optional>
 #include <random>
 
 #include <diagnostic_msgs/DiagnosticArray.h>
@@ -18,8 +19,10 @@
 #include <sensor_msgs/point_cloud2_iterator.h>
 #include <std_srvs/Trigger.h>
 #include <tf2_eigen/tf2_eigen.h>
+#include <tf2_ros/buffer.h>
 #include <tf2_ros/static_transform_broadcaster.h>
 #include <tf2_ros/transform_broadcaster.h>
+#include <tf2_ros/transform_listener.h>
 
 #include "cube_scan_matcher/Status.h"
 #include "cube_scan_matcher/core/pose.h"
@@ -77,7 +80,32 @@ class ScanMatcherRos : public ::testing::Test {
     EXPECT_TRUE(waitFor([&] { return out.status.size() > n; }, 20.0)) << "no status for a cloud";
     return out.status.empty() ? Status{} : out.status.back();
   }
+
+  /// A robot driving 0.5 m per scan along its x axis in `scene` from `body`: the scans
+  /// registered, the odometry on tf as `odom_of(k, truth)`. Returns each scan's stamp.
+  template <typename OdomOf>
+  std::vector<ros::Time> driveStraight(const sim::Scene& scene, Eigen::Isometry3d body, int scans,
+                                       OdomOf odom_of, std::vector<Status>* statuses) {
+    std::mt19937_64 rng(21);
+    std::vector<ros::Time> stamps;
+    ros::Time stamp = ros::Time::now();
+    for (int k = 0; k < scans; ++k) {
+      if (k > 0) {
+        body.translation() += 0.5 * body.linear().col(0);
+        body.translation().z() = scene.groundHeight(body.translation().x(), body.translation().y()) + 0.5;
+      }
+      stamp += ros::Duration(0.5);
+      tf_pub.sendTransform(stampedTransform(odom_of(k, body), "odom", "base_link", stamp));
+      waitFor([] { return false; }, 0.1);
+      statuses->push_back(send(makeCloud(sweepInBase(scene, body, rng), "base_link", stamp)));
+      stamps.push_back(stamp);
+    }
+    return stamps;
+  }
 };
+
+/// The matcher with role anchored (test/ros/anchored.test).
+class ScanMatcherAnchored : public ScanMatcherRos {};
 
 // config/scan_matcher.yaml, loaded by the .test files, holds the code's defaults (the .test
 // files override tf_timeout only).
@@ -88,7 +116,7 @@ TEST(ScanMatcherYaml, LoadsAndEqualsTheDefaults) {
   EXPECT_EQ(p.base_frame, "base_link");
   EXPECT_EQ(p.queue_size, 1);
   EXPECT_EQ(p.path_max_length, NodeParams{}.path_max_length);
-  EXPECT_DOUBLE_EQ(p.sigma_translation, NodeParams{}.sigma_translation);
+  EXPECT_DOUBLE_EQ(p.chain.sigma_m, NodeParams{}.chain.sigma_m);
 }
 
 TEST_F(ScanMatcherRos, RegistersSimulatedSweepsToTheTruth) {
@@ -417,6 +445,99 @@ TEST_F(ScanMatcherRos, InitialPoseRestartsTheChainOnTheGroundPlane) {
   EXPECT_LT(rad2deg(Eigen::AngleAxisd(expected.transpose() * est.linear()).angle()), 0.5);
   EXPECT_NEAR(p.pose.covariance[0], 0.25, 1e-12);  // given
   EXPECT_GT(p.pose.covariance[14], 0.0);            // z: the configured sigma, not RViz's 0
+}
+
+// ~registered_cloud keeps each valid point's intensity (a point dropped as invalid takes its
+// intensity with it), as float32 "intensity".
+TEST_F(ScanMatcherRos, RegisteredCloudCarriesTheIntensityOfEachValidPoint) {
+  std::optional<sensor_msgs::PointCloud2> registered;
+  ros::Subscriber sub = nh.subscribe<sensor_msgs::PointCloud2>(
+      kNs + "registered_cloud", 5,
+      [&](const sensor_msgs::PointCloud2::ConstPtr& m) { registered = *m; });
+  ASSERT_TRUE(waitFor([&] { return sub.getNumPublishers() > 0; }, 10.0));
+  const sim::Scene scene = sim::Scene::generate(sim::SceneType::Urban, 3);
+  std::mt19937_64 rng(13);
+  Eigen::Isometry3d body = Eigen::Isometry3d::Identity();
+  body.translation() = Eigen::Vector3d(3, 1, scene.groundHeight(3, 1) + 0.5);
+  PointArray pts;
+  const float nan = std::numeric_limits<float>::quiet_NaN();
+  pts.push_back(nan, nan, nan);  // no return: dropped
+  const PointArray sweep = sweepInBase(scene, body, rng);
+  for (std::size_t i = 0; i < sweep.size(); ++i) pts.push_back(sweep.x[i], sweep.y[i], sweep.z[i]);
+  std::vector<float> intensity(pts.size());
+  for (std::size_t i = 0; i < pts.size(); ++i) intensity[i] = float(i % 1000);
+  const ros::Time stamp = ros::Time::now();
+  tf_pub.sendTransform(stampedTransform(body, "odom", "base_link", stamp));
+  waitFor([] { return false; }, 0.1);
+  std_msgs::Header h;
+  h.frame_id = "base_link";
+  h.stamp = stamp;
+  send(toCloud(pts, Eigen::Isometry3d::Identity(), h, &intensity));
+  ASSERT_TRUE(waitFor([&] { return registered && registered->header.stamp == stamp; }, 10.0));
+  ASSERT_EQ(registered->width, sweep.size());
+  sensor_msgs::PointCloud2ConstIterator<float> in(*registered, "intensity"), x(*registered, "x");
+  std::size_t wrong = 0;
+  for (std::size_t i = 0; i < sweep.size(); ++i, ++in) wrong += *in != float((i + 1) % 1000);
+  EXPECT_EQ(wrong, 0u) << "intensities out of step with their points";
+  EXPECT_TRUE(std::isfinite(*x));
+}
+
+// role messages (the shipped default): poses and odometry on topics, no map -> odom on tf, so
+// that nothing clashes with another localizer.
+TEST_F(ScanMatcherRos, MessagesRoleSendsNoTf) {
+  tf2_ros::Buffer buffer;
+  tf2_ros::TransformListener listener(buffer);
+  const sim::Scene scene = sim::Scene::generate(sim::SceneType::Urban, 3);
+  Eigen::Isometry3d body = Eigen::Isometry3d::Identity();
+  body.translation() = Eigen::Vector3d(3, 1, scene.groundHeight(3, 1) + 0.5);
+  std::vector<Status> statuses;
+  driveStraight(scene, body, 3, [](int, const Eigen::Isometry3d& b) { return b; }, &statuses);
+  EXPECT_EQ(statuses.back().reason, Status::ACCEPTED) << statuses.back().message;
+  waitFor([] { return false; }, 1.0);
+  EXPECT_FALSE(buffer._frameExists("map")) << "map -> odom published with role messages";
+  EXPECT_FALSE(out.pose.empty());
+}
+
+// role anchored (test/ros/anchored.test): the odometry drifts sideways by 5 cm per scan while
+// the scans show a straight drive. The published pose is the chain pulled towards the
+// odometry: between the two, and map -> odom on tf matches it.
+TEST_F(ScanMatcherAnchored, PullsTheChainTowardsTheOdometry) {
+  tf2_ros::Buffer buffer;
+  tf2_ros::TransformListener listener(buffer);
+  const sim::Scene scene = sim::Scene::generate(sim::SceneType::Urban, 3);
+  Eigen::Isometry3d body = Eigen::Isometry3d::Identity();
+  body.translation() = Eigen::Vector3d(3, 1, scene.groundHeight(3, 1) + 0.5);
+  auto odom_of = [&](int k, const Eigen::Isometry3d& b) {
+    Eigen::Isometry3d o = b;
+    o.translation().y() += 0.05 * k;
+    return o;
+  };
+  std::vector<Status> statuses;
+  const int n = 8;
+  const std::vector<ros::Time> stamps = driveStraight(scene, body, n, odom_of, &statuses);
+  for (int k = 1; k < n; ++k) EXPECT_EQ(statuses[std::size_t(k)].reason, Status::ACCEPTED) << k;
+  ASSERT_TRUE(waitFor([&] { return !out.pose.empty() && out.pose.back().header.stamp == stamps.back(); }, 10.0));
+  Eigen::Isometry3d first, last;
+  tf2::fromMsg(out.pose.front().pose.pose, first);
+  tf2::fromMsg(out.pose.back().pose.pose, last);
+  // The first pose is the odometry's (0 offset); the last lies between the chain (y = 1, the
+  // scans') and the odometry (y = 1.35), strictly.
+  EXPECT_NEAR(first.translation().y(), 1.0, 1e-6);
+  const double y = last.translation().y();
+  EXPECT_GT(y, 1.0 + 0.01) << "not pulled towards the odometry";
+  EXPECT_LT(y, 1.0 + 0.05 * (n - 1) - 0.01) << "the chain's motion ignored";
+  // map -> odom: map -> odom -> base_link is the published pose.
+  ASSERT_TRUE(waitFor([&] { return buffer.canTransform("map", "odom", ros::Time(0)); }, 5.0));
+  const Eigen::Isometry3d map_odom = tf2::transformToEigen(buffer.lookupTransform("map", "odom", ros::Time(0)));
+  Eigen::Isometry3d odom_last = Eigen::Isometry3d::Identity();
+  tf2::fromMsg(out.odom.back().pose.pose, odom_last);
+  EXPECT_LT((odom_last.inverse() * last).translation().norm(), 1e-9);  // the same pose on both
+  Eigen::Isometry3d truth_last = body;
+  truth_last.translation() += 0.5 * (n - 1) * body.linear().col(0);
+  truth_last.translation().z() =
+      scene.groundHeight(truth_last.translation().x(), truth_last.translation().y()) + 0.5;
+  const Eigen::Isometry3d expected = map_odom * odom_of(n - 1, truth_last);
+  EXPECT_LT((expected.inverse() * last).translation().norm(), 1e-3);
 }
 
 // Run alone with a bad parameter (test/ros/bad_param.test): the matcher refuses to start and

@@ -51,7 +51,7 @@ void unloadTwentyTimes(const std::string& name, const std::string& type) {
 TEST(Unload, ScanMatcherOutlivingItsUnloadIsDestroyedSafely) {
   // map -> odom at 100 Hz: a timer on the multi-threaded queue beside the single-threaded
   // queue's diagnostics timer, subscriber, services and dynamic_reconfigure server.
-  ros::param::set("/unload_test/scan_matcher/publish_tf", true);
+  ros::param::set("/unload_test/scan_matcher/role", std::string("map_odom"));
   ros::param::set("/unload_test/scan_matcher/tf_rate", 100.0);
   unloadTwentyTimes("/unload_test/scan_matcher", "ScanMatcherNodelet");
   EXPECT_TRUE(ros::ok());

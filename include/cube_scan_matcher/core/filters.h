@@ -2,6 +2,7 @@
 #pragma once
 
 #include <cstddef>
+#include <cstdint>
 #include <vector>
 
 #include <Eigen/Core>
@@ -36,6 +37,14 @@ FilterStats appendFiltered(const float* x, const float* y, const float* z, std::
 /// Filters a PointArray (convenience over appendFiltered).
 PointArray filterPoints(const PointArray& in, const RangeFilterSettings& settings,
                         FilterStats* stats = nullptr);
+
+/// The indices of the points of `in` that filterPoints keeps, in order: finite, within range,
+/// and, when `times` is not empty, with a finite time. For values that travel with the points
+/// (times, intensities): gather them with these. Throws std::invalid_argument if `times` is
+/// neither empty nor one per point.
+std::vector<std::uint32_t> keptIndices(const PointArray& in, const std::vector<float>& times,
+                                       const RangeFilterSettings& settings,
+                                       FilterStats* stats = nullptr);
 
 /// The same with a time per point: the kept points' times go to `times_out` (a point whose time
 /// is NaN or inf is dropped as non-finite). Throws std::invalid_argument on a size mismatch.

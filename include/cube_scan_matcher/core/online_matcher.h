@@ -90,6 +90,9 @@ struct OnlineStep {
   bool time_reset = false;         ///< time went backwards: state was reset before this scan.
   bool rejection_alarm = false;    ///< consecutive rejections >= max_consecutive_rejections.
   bool deskewed = false;           ///< the points were re-placed with the registered motion.
+  /// When deskewed: the scan's points re-placed (base frame at the stamp), one per input point
+  /// in the same order; the keyframe holds the same.
+  PointArray deskewed_points;
   int reregistered = 0;            ///< de-skew rounds whose registration was kept (the result is the last's).
   int consecutive_rejections = 0;
   /// The gate's max_correction bounds were multiplied by this: the time since the reference

@@ -6,6 +6,7 @@
 
 #include <vector>
 
+#include <Eigen/Core>
 #include <Eigen/Geometry>
 
 namespace cube_scan_matcher {
@@ -39,5 +40,22 @@ struct StationaryDrift {
 /// first, how far the estimate moves from its value at that first scan.
 StationaryDrift stationaryDrift(const Trajectory& truth, const Trajectory& estimate,
                                 double still_m = 1e-3, double still_deg = 0.01);
+
+/// How well predicted covariances describe the errors they claim (filter consistency).
+/// Errors per pose in the covariance's convention (pose_covariance.h): e = [t_est - t_true,
+/// log(R_est R_true^T)] [m, rad], map axes. For a consistent 6-D Gaussian, about 68 % of an
+/// axis's errors lie within 1 sd, 0.27 % beyond 3 sd, and the NEES e^T C^-1 e averages 6.
+struct CovarianceConsistency {
+  int poses = 0;                       ///< poses evaluated
+  Eigen::Matrix<double, 6, 1> within1 = Eigen::Matrix<double, 6, 1>::Zero();  ///< share |e_i| <= sd_i
+  Eigen::Matrix<double, 6, 1> beyond3 = Eigen::Matrix<double, 6, 1>::Zero();  ///< share |e_i| > 3 sd_i
+  double nees_mean = 0.0, nees_median = 0.0;
+};
+
+/// Over the poses k with use[k] (all when `use` is empty): covariances[k] is estimate[k]'s
+/// covariance [m^2, rad^2]. A pose whose covariance is not positive definite is skipped.
+CovarianceConsistency covarianceConsistency(
+    const Trajectory& truth, const Trajectory& estimate,
+    const std::vector<Eigen::Matrix<double, 6, 6>>& covariances, const std::vector<bool>& use = {});
 
 }  // namespace cube_scan_matcher

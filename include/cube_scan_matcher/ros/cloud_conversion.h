@@ -25,13 +25,17 @@ class CloudError : public std::runtime_error {
 PointArray fromCloud(const sensor_msgs::PointCloud2& cloud,
                      const Eigen::Isometry3d& transform = Eigen::Isometry3d::Identity());
 
-/// The `field` of every point as seconds (FLOAT32 or FLOAT64), width * height of them in
-/// fromCloud()'s order; empty if the cloud has no such field. Throws CloudError if the field
-/// has another type or lies outside point_step (the layout is checked as fromCloud() does).
-std::vector<float> readTimes(const sensor_msgs::PointCloud2& cloud, const std::string& field);
+/// The `field` of every point as float (FLOAT32 or FLOAT64: times in seconds, intensities),
+/// width * height of them in fromCloud()'s order; empty if the cloud has no such field. Throws
+/// CloudError if the field has another type or lies outside point_step (the layout is checked
+/// as fromCloud() does).
+std::vector<float> readFloatField(const sensor_msgs::PointCloud2& cloud, const std::string& field);
 
-/// A dense float32 x/y/z cloud of `points` transformed by `transform`.
+/// A dense float32 x/y/z cloud of `points` transformed by `transform`, with a float32
+/// "intensity" field when `intensity` (one per point) is given. Throws std::invalid_argument
+/// on a size mismatch.
 sensor_msgs::PointCloud2 toCloud(const PointArray& points, const Eigen::Isometry3d& transform,
-                                 const std_msgs::Header& header);
+                                 const std_msgs::Header& header,
+                                 const std::vector<float>* intensity = nullptr);
 
 }  // namespace cube_scan_matcher

@@ -8,7 +8,9 @@
 #include <ros/node_handle.h>
 
 #include "cube_scan_matcher/ScanMatcherConfig.h"
+#include "cube_scan_matcher/core/chain_covariance.h"
 #include "cube_scan_matcher/core/filters.h"
+#include "cube_scan_matcher/core/odometry_anchor.h"
 #include "cube_scan_matcher/core/online_matcher.h"
 #include "cube_scan_matcher/ros/read_param.h"
 
@@ -22,8 +24,18 @@ struct NodeParams {
   // tf.
   double tf_timeout = 0.1;        ///< [s] bounded wait for each tf lookup, in [0, 10].
   bool skip_without_tf = false;   ///< missing_tf_policy: "skip" (true) or "identity" (false).
-  bool publish_tf = false;        ///< publish map_frame -> odom_frame (REP-105).
+  /// What the node is in a REP-105 tree (README "Using it on a robot"):
+  ///  - Messages: pose, odometry and path only, no tf: a filter (robot_localization) fuses them;
+  ///  - MapOdom: also map -> odom from the chain (map drifts from odom along the run);
+  ///  - Anchored: map -> odom from the chain tied to the odometry (odometry_anchor.h), so that
+  ///    map stays within the odometry's error of odom; the pose topics carry that pose.
+  enum class Role { Messages, MapOdom, Anchored } role = Role::Messages;
+  OdometryAnchorSettings anchor;  ///< Anchored: the odometry's absolute accuracy.
   double transform_tolerance = 0.1;  ///< [s] map -> odom is post-dated by this, in [0, 10].
+  bool publishesTf() const { return role != Role::Messages; }
+  /// ~reset: the new chain starts at the last published pose moved on by the odometry (map
+  /// stays continuous) instead of at the next scan's odometry pose.
+  bool reset_continuous = false;
   double tf_rate = 20.0;          ///< [Hz] map -> odom re-sent at this rate, in [0.1, 1000].
   // Input and outputs.
   int queue_size = 1;             ///< subscriber queue, in [1, 100].
@@ -32,10 +44,10 @@ struct NodeParams {
   /// Field of the per-point times [s, relative to the stamp] (the sweep assembler's "time");
   /// empty: none read. Clouds without it are rigid sweeps.
   std::string time_field = "time";
-  // Covariance of the published pose (diagonal, standard deviations).
-  double sigma_translation = 0.05;   ///< [m] of an accepted registration.
-  double sigma_rotation = 0.5;       ///< [deg] of an accepted registration.
-  double rejected_sigma_scale = 10;  ///< sigmas times this for an odometry-propagated scan.
+  /// Covariance of the published pose along the chain (ROS parameters sigma_translation [m],
+  /// sigma_rotation [deg], registration_sigma_scale, drift_percent [%],
+  /// rejected_sigma_translation [m], rejected_sigma_rotation [deg]).
+  ChainCovarianceSettings chain;
   // Diagnostics.
   double min_rate = 0.05;         ///< [Hz] input rate below this is a WARN.
   double max_rate = 100.0;        ///< [Hz] input rate above this is a WARN.

@@ -28,6 +28,7 @@
 #include "cube_scan_matcher/SetPose.h"
 #include "cube_scan_matcher/ScanMatcherConfig.h"
 #include "cube_scan_matcher/Status.h"
+#include "cube_scan_matcher/core/chain_covariance.h"
 #include "cube_scan_matcher/core/online_matcher.h"
 #include "cube_scan_matcher/core/pose_covariance.h"
 #include "cube_scan_matcher/core/vector6.h"
@@ -56,6 +57,7 @@ class ScanMatcherNodelet : public nodelet::Nodelet {
     std::optional<Eigen::Isometry3d> odom;  ///< T_odom_base at the stamp, if tf had it
     PointArray points;                      ///< valid points in base_frame
     std::optional<PointTimes> times;        ///< their times, from the cloud's time_field
+    std::optional<std::vector<float>> intensity;  ///< their "intensity" field, if the cloud has one
   };
   void countArrival(Scan& scan);    ///< input rate and dropped scans (header.seq gaps)
   bool checkHeader(Scan& scan);     ///< a stamp and a frame
@@ -108,15 +110,20 @@ class ScanMatcherNodelet : public nodelet::Nodelet {
   std::optional<Eigen::Isometry3d> map_odom_;
   ros::Timer tf_timer_;
 
-  // Covariance of the current keyframe's pose in the map frame (pose_covariance.h): a scan's
-  // published covariance is this compounded with its increment's (compoundCovariance); it grows
-  // from keyframe to keyframe and restarts at the first scan of a chain.
-  Matrix6d keyframe_cov_ = Matrix6d::Zero();
-  std::optional<Matrix6d> start_cov_;  // from ~set_pose, for the next first scan
+  std::unique_ptr<ChainCovariance> chain_;  // the published pose's covariance along the chain
+  std::unique_ptr<OdometryAnchor> anchor_;  // role anchored: the chain tied to the odometry
   // The last twist published with an estimate [m/s, rad/s] in base_frame (none at a chain's
   // start): its change to the next one is the motion model's error (twistCovariance).
   std::optional<Vector6d> last_twist_;
   std::optional<Eigen::Isometry3d> last_pose_;  // T_map_base published last (this chain)
+  std::optional<Eigen::Isometry3d> last_odom_;  // T_odom_base at that scan, if known
+  // A chain's start given for a time (~set_pose's stamp, a continuous ~reset's last scan): the
+  // pose then and the odometry then (none: the pose holds at the next scan as it is).
+  struct PendingStart {
+    Eigen::Isometry3d pose;
+    std::optional<Eigen::Isometry3d> odom;
+  };
+  std::optional<PendingStart> pending_start_;
 
   nav_msgs::Path path_;
   std::optional<std::uint32_t> last_seq_;

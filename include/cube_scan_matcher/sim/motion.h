@@ -90,9 +90,13 @@ enum class OdometryError {
   None,   ///< odometry = truth
   Small,  ///< each increment off by uniform +-0.25 m, +-2 deg per parameter (paper "small")
   Big,    ///< each increment off by uniform +-1 m, +-8 deg per parameter (paper "big")
-  Drift,  ///< DGPS-like: a slowly wandering offset (random walk, 5 cm and 0.3 deg per sweep)
+  Drift,  ///< a slowly wandering offset (random walk, 5 cm and 0.3 deg per sweep): unbounded
+  /// Globally referenced (DGPS/IMU): an offset from the truth in world axes that wanders but
+  /// stays bounded (first-order Gauss-Markov, correlation time 20 sweeps; stationary sd 0.3 m
+  /// per position axis, 0.2 deg roll and pitch, 0.5 deg yaw).
+  Dgps,
 };
-/// "none", "small", "big", "drift"; throws std::invalid_argument otherwise.
+/// "none", "small", "big", "drift", "dgps"; throws std::invalid_argument otherwise.
 OdometryError odometryErrorFromString(const std::string& name);
 
 /// T_odom_base per sweep. The first sweep's odometry equals the truth (map = odom = world).
@@ -108,6 +112,7 @@ class OdometrySimulator {
   Eigen::Isometry3d last_truth_ = Eigen::Isometry3d::Identity();
   Eigen::Isometry3d last_odom_ = Eigen::Isometry3d::Identity();
   Eigen::Isometry3d bias_ = Eigen::Isometry3d::Identity();
+  Eigen::Matrix<double, 6, 1> offset_ = Eigen::Matrix<double, 6, 1>::Zero();  ///< Dgps [m, rad]
 };
 
 }  // namespace cube_scan_matcher::sim
