@@ -50,13 +50,17 @@ StepCovariance ChainCovariance::add(const OnlineStep& step) {
   };
   StepCovariance out;
   Matrix6d random, increment_map;
-  if (step.reason == GateReason::FirstScan) {
+  // A first scan that could not become the reference (BadReference) starts the chain too, and
+  // the next scan, again a first one, starts it over with the same start covariance.
+  const bool chain_start =
+      step.reason == GateReason::FirstScan || step.reason == GateReason::BadReference;
+  if (chain_start) {
     out.increment = diagonalCovariance(st, sr);
     random = start_ ? *start_ : out.increment;
     out.motion = out.increment;
     increment_map = Matrix6d::Zero();
     start_position_ = step.pose.translation();
-    start_.reset();
+    if (step.reason == GateReason::FirstScan) start_.reset();
   } else {
     const double scale = settings_.registration_scale;
     out.increment = step.accepted ? floorCovariance(scale * scale * step.result.covariance, st, sr)

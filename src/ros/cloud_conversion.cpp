@@ -74,17 +74,46 @@ PointArray fromCloud(const sensor_msgs::PointCloud2& cloud, const Eigen::Isometr
   return out;
 }
 
-std::vector<float> readFloatField(const sensor_msgs::PointCloud2& cloud, const std::string& name) {
-  const sensor_msgs::PointField* f = findField(cloud, name);
-  if (!f) return {};
-  const std::uint8_t type = f->datatype;
-  if (type != sensor_msgs::PointField::FLOAT32 && type != sensor_msgs::PointField::FLOAT64) {
-    throw CloudError("cloud field " + name + " (point times) must be FLOAT32 or FLOAT64 seconds, "
-                     "datatype " + std::to_string(type));
+namespace {
+
+// Size in bytes of a PointField datatype; 0 for an unknown one.
+std::size_t datatypeSize(std::uint8_t type) {
+  switch (type) {
+    case sensor_msgs::PointField::INT8:
+    case sensor_msgs::PointField::UINT8: return 1;
+    case sensor_msgs::PointField::INT16:
+    case sensor_msgs::PointField::UINT16: return 2;
+    case sensor_msgs::PointField::INT32:
+    case sensor_msgs::PointField::UINT32:
+    case sensor_msgs::PointField::FLOAT32: return 4;
+    case sensor_msgs::PointField::FLOAT64: return 8;
+    default: return 0;
   }
-  const std::size_t size = type == sensor_msgs::PointField::FLOAT32 ? 4 : 8;
-  if (f->offset + size > cloud.point_step) {
-    throw CloudError("cloud field " + name + " lies outside point_step");
+}
+
+float readScalar(const std::uint8_t* p, std::uint8_t type) {
+  switch (type) {
+    case sensor_msgs::PointField::INT8: return float(readAs<std::int8_t>(p));
+    case sensor_msgs::PointField::UINT8: return float(readAs<std::uint8_t>(p));
+    case sensor_msgs::PointField::INT16: return float(readAs<std::int16_t>(p));
+    case sensor_msgs::PointField::UINT16: return float(readAs<std::uint16_t>(p));
+    case sensor_msgs::PointField::INT32: return float(readAs<std::int32_t>(p));
+    case sensor_msgs::PointField::UINT32: return float(readAs<std::uint32_t>(p));
+    case sensor_msgs::PointField::FLOAT32: return readAs<float>(p);
+    default: return float(readAs<double>(p));
+  }
+}
+
+// Every point's value of field `f` as float, after the layout checks fromCloud() makes.
+std::vector<float> readField(const sensor_msgs::PointCloud2& cloud,
+                             const sensor_msgs::PointField& f) {
+  const std::size_t size = datatypeSize(f.datatype);
+  if (size == 0) {
+    throw CloudError("cloud field " + f.name + " has unknown datatype " +
+                     std::to_string(f.datatype));
+  }
+  if (f.offset + size > cloud.point_step) {
+    throw CloudError("cloud field " + f.name + " lies outside point_step");
   }
   const std::size_t width = cloud.width, height = cloud.height;
   if (width * height == 0) return {};
@@ -97,11 +126,35 @@ std::vector<float> readFloatField(const sensor_msgs::PointCloud2& cloud, const s
   for (std::size_t r = 0; r < height; ++r) {
     const std::uint8_t* row = cloud.data.data() + r * cloud.row_step;
     for (std::size_t c = 0; c < width; ++c) {
-      const std::uint8_t* p = row + c * cloud.point_step + f->offset;
-      out.push_back(size == 4 ? readAs<float>(p) : float(readAs<double>(p)));
+      out.push_back(readScalar(row + c * cloud.point_step + f.offset, f.datatype));
     }
   }
   return out;
+}
+
+}  // namespace
+
+std::vector<float> readFloatField(const sensor_msgs::PointCloud2& cloud, const std::string& name) {
+  const sensor_msgs::PointField* f = findField(cloud, name);
+  if (!f) return {};
+  if (f->datatype != sensor_msgs::PointField::FLOAT32 &&
+      f->datatype != sensor_msgs::PointField::FLOAT64) {
+    throw CloudError("cloud field " + name + " (point times) must be FLOAT32 or FLOAT64 seconds, "
+                     "datatype " + std::to_string(f->datatype));
+  }
+  return readField(cloud, *f);
+}
+
+std::optional<std::vector<float>> readIntensity(const sensor_msgs::PointCloud2& cloud,
+                                                std::string& problem) {
+  const sensor_msgs::PointField* f = findField(cloud, "intensity");
+  if (!f) return std::vector<float>{};
+  try {
+    return readField(cloud, *f);
+  } catch (const CloudError& e) {
+    problem = e.what();
+    return std::nullopt;
+  }
 }
 
 sensor_msgs::PointCloud2 toCloud(const PointArray& points, const Eigen::Isometry3d& transform,

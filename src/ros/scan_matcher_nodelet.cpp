@@ -145,13 +145,17 @@ bool ScanMatcherNodelet::resetService(std_srvs::Trigger::Request&, std_srvs::Tri
   std::lock_guard<std::mutex> lock(mutex_);
   // Continuous: the new chain starts where the old one was, moved on by the odometry from the
   // last published scan to the next one, so that map does not jump.
+  // Its covariance goes on too: the new chain is known no better than the old one's end.
   const std::optional<Eigen::Isometry3d> last_pose = last_pose_, last_odom = last_odom_;
+  const std::optional<Matrix6d> last_covariance = last_covariance_;
   resetState("reset requested through the ~reset service");
   res.success = true;
   res.message = "reference, pose chain, path and counters reset";
   if (params_.reset_continuous && last_pose) {
     matcher_->restartAt(*last_pose);
     pending_start_ = PendingStart{*last_pose, last_odom};
+    chain_->restart(last_covariance);
+    anchor_->reset(last_covariance);
     res.message += "; the new chain continues from the last pose";
   }
   return true;
@@ -159,7 +163,7 @@ bool ScanMatcherNodelet::resetService(std_srvs::Trigger::Request&, std_srvs::Tri
 
 bool ScanMatcherNodelet::setPoseService(SetPose::Request& req, SetPose::Response& res) {
   std::lock_guard<std::mutex> lock(mutex_);
-  const std::string refused = restartChain(req.pose, "~set_pose");
+  const std::string refused = restartChain(req.pose, "~set_pose", false);
   res.success = refused.empty();
   res.message = res.success ? "the next scan starts a new chain at the given pose" : refused;
   if (!res.success) NODELET_WARN("~set_pose refused: %s", refused.c_str());
@@ -169,8 +173,8 @@ bool ScanMatcherNodelet::setPoseService(SetPose::Request& req, SetPose::Response
 void ScanMatcherNodelet::initialPoseCallback(
     const geometry_msgs::PoseWithCovarianceStampedConstPtr& msg) {
   // RViz's "2D Pose Estimate" gives x, y and yaw on the ground plane (z 0, level): a 3D chain
-  // keeps z, roll and pitch of its last pose (none before the first scan: 0), and their
-  // variances stay the configured ones.
+  // keeps z, roll and pitch of its last pose (none before the first scan: 0) with their
+  // variances (none before the first scan: unknown).
   std::lock_guard<std::mutex> lock(mutex_);
   geometry_msgs::PoseWithCovarianceStamped pose = *msg;
   const auto& o = msg->pose.pose.orientation;
@@ -186,17 +190,19 @@ void ScanMatcherNodelet::initialPoseCallback(
     pose.pose.pose.orientation.w = merged.w(), pose.pose.pose.orientation.x = merged.x();
     pose.pose.pose.orientation.y = merged.y(), pose.pose.pose.orientation.z = merged.z();
     pose.pose.pose.position.z = last.translation().z();
-    for (const int i : {2, 3, 4}) {  // z, roll, pitch: not given, so not known better than sigma
+    for (const int i : {2, 3, 4}) {  // z, roll, pitch: not given
       for (int j = 0; j < 6; ++j) pose.pose.covariance[std::size_t(6 * i + j)] = 0.0;
       for (int j = 0; j < 6; ++j) pose.pose.covariance[std::size_t(6 * j + i)] = 0.0;
+      if (last_covariance_) pose.pose.covariance[std::size_t(7 * i)] = (*last_covariance_)(i, i);
     }
   }
-  const std::string refused = restartChain(pose, "initialpose");
+  const std::string refused = restartChain(pose, "initialpose", true);
   if (!refused.empty()) NODELET_WARN("initialpose refused: %s", refused.c_str());
 }
 
 std::string ScanMatcherNodelet::restartChain(const geometry_msgs::PoseWithCovarianceStamped& req,
-                                             const std::string& source) {
+                                             const std::string& source,
+                                             bool stamp_is_approximate) {
   const auto& p = req.pose.pose;
   const Eigen::Quaterniond q(p.orientation.w, p.orientation.x, p.orientation.y, p.orientation.z);
   const Eigen::Vector3d t(p.position.x, p.position.y, p.position.z);
@@ -216,24 +222,31 @@ std::string ScanMatcherNodelet::restartChain(const geometry_msgs::PoseWithCovari
   if (!req.header.stamp.isZero()) {
     std::string error;
     odom_at_stamp = lookup(params_.odom_frame, params_.base_frame, req.header.stamp, error);
-    if (!odom_at_stamp) {
+    if (!odom_at_stamp && !stamp_is_approximate) {
       return "no odometry at the pose's stamp " + std::to_string(req.header.stamp.toSec()) +
              " s (" + error + "); send it with a zero stamp to start the next scan there";
+    }
+    if (!odom_at_stamp) {
+      NODELET_INFO("%s: no odometry at its stamp %.3f s (%s): the pose holds at the next scan",
+                   source.c_str(), req.header.stamp.toSec(), error.c_str());
     }
   }
   resetState("pose set through " + source);
   matcher_->restartAt(pose);
   pending_start_ = PendingStart{pose, odom_at_stamp};
-  // The request's covariance; a variance it leaves at 0 (unknown) becomes the configured one.
+  // The request's covariance; a variance it leaves at 0 (unknown) becomes the one of a scan
+  // whose registration was rejected (rejected_sigma_m, rejected_sigma_deg): loose, not the
+  // floors of a registration.
   const auto& c = req.pose.covariance;
   Matrix6d start = Matrix6d::Zero();
   for (int i = 0; i < 6; ++i) {
     for (int j = 0; j < 6; ++j) start(i, j) = c[std::size_t(6 * i + j)];
   }
   start = 0.5 * (start + start.transpose());
-  const Matrix6d floors = diagonalCovariance(chain_->settings().sigma_m, chain_->settings().sigma_rad);
+  const ChainCovarianceSettings& cs = chain_->settings();
+  const Matrix6d unknown = diagonalCovariance(cs.rejected_sigma_m, cs.rejected_sigma_rad);
   for (int i = 0; i < 6; ++i) {
-    if (!(start(i, i) > 0.0)) start(i, i) = floors(i, i);
+    if (!(start(i, i) > 0.0)) start(i, i) = unknown(i, i);
   }
   chain_->restart(start);
   anchor_->reset(start);
@@ -254,6 +267,7 @@ void ScanMatcherNodelet::resetState(const std::string& why) {
   last_odom_.reset();
   last_twist_.reset();
   last_pose_.reset();
+  last_covariance_.reset();
 }
 
 std::optional<Eigen::Isometry3d> ScanMatcherNodelet::lookup(const std::string& target,
@@ -403,7 +417,14 @@ bool ScanMatcherNodelet::convertPoints(Scan& scan) {
     const PointArray all = fromCloud(scan.msg, scan.T_base_cloud);
     const std::vector<float> tau =
         params_.time_field.empty() ? std::vector<float>{} : readFloatField(scan.msg, params_.time_field);
-    const std::vector<float> intensity = readFloatField(scan.msg, "intensity");
+    // An unreadable intensity drops the intensity, never the scan.
+    std::string intensity_problem;
+    const std::vector<float> intensity =
+        readIntensity(scan.msg, intensity_problem).value_or(std::vector<float>{});
+    if (!intensity_problem.empty()) {
+      NODELET_WARN_THROTTLE(10.0, "intensity not carried to ~registered_cloud: %s",
+                            intensity_problem.c_str());
+    }
     // The points kept, and with them their times and intensities.
     const std::vector<std::uint32_t> kept = keptIndices(all, tau, params_.filter, &fs);
     auto gather = [&kept](const std::vector<float>& v, std::vector<float>& out) {
@@ -442,7 +463,14 @@ OnlineStep ScanMatcherNodelet::registerScan(Scan& scan) {
   // odometry from when it held to this scan.
   if (pending_start_) {
     if (pending_start_->odom && scan.odom) {
-      matcher_->restartAt(pending_start_->pose * pending_start_->odom->inverse() * *scan.odom);
+      const Eigen::Isometry3d start =
+          pending_start_->pose * pending_start_->odom->inverse() * *scan.odom;
+      if (start.matrix().allFinite()) {
+        matcher_->restartAt(start);
+      } else {
+        NODELET_WARN("the chain's start moved on by the odometry is not finite: it starts at "
+                     "the given pose as it is");
+      }
     }
     pending_start_.reset();
   }
@@ -518,6 +546,7 @@ void ScanMatcherNodelet::publishPose(const Scan& scan, const OnlineStep& step) {
   pose.pose.covariance = toMsg(published_cov);
   pose_pub_.publish(pose);
   last_pose_ = published;
+  last_covariance_ = published_cov;
   last_odom_ = scan.odom;
 
   nav_msgs::Odometry odometry;

@@ -64,6 +64,20 @@ TEST(ChainCovariance, StartsAtTheFloorsAndCompoundsKeyframeByKeyframe) {
                   .pose.isApprox(4.0 * floors));
 }
 
+// A first scan whose grid could not be built (BadReference) is a chain start, not an increment
+// from a keyframe that does not exist, and the first scan after it starts at the same covariance.
+TEST(ChainCovariance, AFirstScanThatCouldNotBeTheReferenceStartsTheChain) {
+  ChainCovariance chain(ChainCovarianceSettings{});
+  const Matrix6d start = diagonalCovariance(0.3, deg2rad(2.0));
+  chain.restart(start);
+  const Eigen::Isometry3d far = poseAt(50, 20, 30);
+  OnlineStep bad = chainStep(GateReason::BadReference, far, Eigen::Isometry3d::Identity(), false);
+  bad.registered = false;
+  EXPECT_TRUE(chain.add(bad).pose.isApprox(start));
+  EXPECT_TRUE(chain.add(chainStep(GateReason::FirstScan, far, Eigen::Isometry3d::Identity(), true))
+                  .pose.isApprox(start));
+}
+
 TEST(ChainCovariance, RegistrationScaleAndSystematicDrift) {
   ChainCovarianceSettings cs;
   cs.sigma_m = 1e-4, cs.sigma_rad = 1e-5, cs.registration_scale = 0.5;

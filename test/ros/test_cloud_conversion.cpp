@@ -141,3 +141,33 @@ TEST(CloudConversion, PointTimesAreReadBesideThePointsAndFilteredWithThem) {
     EXPECT_NE(std::string(e.what()).find("time"), std::string::npos) << e.what();
   }
 }
+
+// Drivers write intensity as uint8, uint16 or float32: each is read as float, and an
+// unreadable one is reported without throwing (the scan stays usable).
+TEST(CloudConversion, IntensityOfAnyScalarTypeIsReadAsFloat) {
+  sensor_msgs::PointCloud2 c;
+  sensor_msgs::PointCloud2Modifier m(c);
+  m.setPointCloud2Fields(4, "x", 1, sensor_msgs::PointField::FLOAT32, "y", 1,
+                         sensor_msgs::PointField::FLOAT32, "z", 1, sensor_msgs::PointField::FLOAT32,
+                         "intensity", 1, sensor_msgs::PointField::UINT16);
+  m.resize(3);
+  sensor_msgs::PointCloud2Iterator<std::uint16_t> in(c, "intensity");
+  const std::uint16_t values[3] = {0, 700, 65535};
+  for (int i = 0; i < 3; ++i, ++in) *in = values[i];
+  std::string problem;
+  const auto intensity = readIntensity(c, problem);
+  ASSERT_TRUE(intensity) << problem;
+  EXPECT_EQ(*intensity, (std::vector<float>{0.0f, 700.0f, 65535.0f}));
+  EXPECT_TRUE(problem.empty());
+
+  c.fields[3].datatype = 42;  // no such datatype
+  EXPECT_FALSE(readIntensity(c, problem));
+  EXPECT_NE(problem.find("intensity"), std::string::npos) << problem;
+
+  sensor_msgs::PointCloud2 none = c;
+  none.fields.pop_back();
+  problem.clear();
+  const auto absent = readIntensity(none, problem);
+  ASSERT_TRUE(absent);
+  EXPECT_TRUE(absent->empty());
+}

@@ -563,6 +563,11 @@ TEST_F(FaultsContinuousReset, ResetKeepsTheMapContinuous) {
   tf2::fromMsg(out.poseAt(stampOf(4))->pose.pose, p4);
   const Eigen::Isometry3d expected = p3 * drive.odom[3].inverse() * drive.odom[4];
   EXPECT_LT((expected.inverse() * p4).translation().norm(), 1e-6);
+  // The covariance goes on too: the new chain is known as well as the old one's end, not
+  // better (the floors of a fresh chain).
+  const auto& c3 = out.poseAt(stampOf(3))->pose.covariance;
+  const auto& c4 = out.poseAt(stampOf(4))->pose.covariance;
+  for (const int i : {0, 7, 14, 21, 28, 35}) EXPECT_NEAR(c4[i], c3[i], 1e-12) << "entry " << i;
   // The odometry's errors since the chain's start put its own pose elsewhere: a reset that
   // starts there would jump by this much.
   EXPECT_GT((drive.odom[4].inverse() * p4).translation().norm(), 0.02);

@@ -59,7 +59,8 @@ class ChainCovariance {
   explicit ChainCovariance(const ChainCovarianceSettings& settings);  // validates
 
   /// The covariances of `step` (steps in the order OnlineMatcher::process returned them).
-  /// A first scan starts the chain at the start covariance (restart's, else the floors); an
+  /// A first scan (also one rejected as BadReference) starts the chain at the start covariance
+  /// (restart's, else the floors); an
   /// accepted increment carries its registration's covariance floored, a rejected one the
   /// rejected sigmas; a step that made a new keyframe keeps its covariance for the
   /// steps that follow. Standing still (no new keyframe) the covariance does not grow.

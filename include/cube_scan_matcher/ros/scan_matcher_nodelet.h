@@ -74,9 +74,11 @@ class ScanMatcherNodelet : public nodelet::Nodelet {
   /// RViz's "2D Pose Estimate" (topic initialpose): x, y and yaw restart the chain.
   void initialPoseCallback(const geometry_msgs::PoseWithCovarianceStampedConstPtr& msg);
   /// ~set_pose and initialpose: the next scan starts a new chain at `pose` (map_frame); the
-  /// reason it was refused, or empty.
+  /// reason it was refused, or empty. With `stamp_is_approximate` (a pose clicked in RViz,
+  /// stamped with its clock) a stamp the odometry cannot be looked up at means "now": the pose
+  /// holds at the next scan.
   std::string restartChain(const geometry_msgs::PoseWithCovarianceStamped& pose,
-                           const std::string& source);
+                           const std::string& source, bool stamp_is_approximate);
   void reconfigure(ScanMatcherConfig& config, uint32_t level);
   /// T_target_source at `stamp`, waiting at most ~tf_timeout; nullopt (and counted) on failure.
   std::optional<Eigen::Isometry3d> lookup(const std::string& target, const std::string& source,
@@ -116,6 +118,7 @@ class ScanMatcherNodelet : public nodelet::Nodelet {
   // start): its change to the next one is the motion model's error (twistCovariance).
   std::optional<Vector6d> last_twist_;
   std::optional<Eigen::Isometry3d> last_pose_;  // T_map_base published last (this chain)
+  std::optional<Matrix6d> last_covariance_;     // its covariance [m², rad²]
   std::optional<Eigen::Isometry3d> last_odom_;  // T_odom_base at that scan, if known
   // A chain's start given for a time (~set_pose's stamp, a continuous ~reset's last scan): the
   // pose then and the odometry then (none: the pose holds at the next scan as it is).
