@@ -655,7 +655,7 @@ def anchored_table(rows):
             group = [r for r in rows if r["odometry"] == odo and r["method"] == method]
             if not group:
                 continue
-            err = [float(r["max_error_m"]) for r in group]
+            err = [float(r["max_error_m"]) for r in group if r["max_error_m"]]
             rpe = [float(r["rpe10_pct"]) for r in group if r["rpe10_pct"]]
             print("| %s | %d | %s | %.2f (%s) | %s |" % (
                 odo, len(group), method, statistics.median(err), span(err, "%.2f"),
