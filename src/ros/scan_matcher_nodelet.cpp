@@ -1,6 +1,7 @@
 #include "cube_scan_matcher/ros/scan_matcher_nodelet.h"
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <iomanip>
 #include <sstream>
@@ -55,6 +56,14 @@ ScanMatcherNodelet::~ScanMatcherNodelet() {
   reset_srv_.shutdown();
   set_pose_srv_.shutdown();
   initialpose_sub_.shutdown();
+  // The worker finishes the scan it is on (a registration is not interrupted), then stops;
+  // it may still touch the reconfigure server, so it goes first.
+  {
+    std::lock_guard<std::mutex> lock(inbox_mutex_);
+    stopping_ = true;
+  }
+  inbox_cv_.notify_all();
+  if (worker_.joinable()) worker_.join();
   reconfigure_server_.reset();
 }
 
@@ -65,8 +74,10 @@ void ScanMatcherNodelet::onInit() {
   updater_ = std::make_unique<diagnostic_updater::Updater>(nh, pnh, getName());
   updater_->setHardwareID("none");
   updater_->add("registration", this, &ScanMatcherNodelet::diagnose);
+  // force_update: update() publishes only once its own period has passed since the last
+  // time, so a timer tick that comes a little early is skipped (a 2 s gap).
   diagnostics_timer_ = nh.createTimer(ros::Duration(1.0), [this](const ros::TimerEvent&) {
-    updater_->update();
+    updater_->force_update();
   });
   try {
     params_ = loadParams(pnh);
@@ -80,6 +91,8 @@ void ScanMatcherNodelet::onInit() {
   matcher_ = std::make_unique<OnlineMatcher>(params_.matcher);
   chain_ = std::make_unique<ChainCovariance>(params_.chain);
   anchor_ = std::make_unique<OdometryAnchor>(params_.anchor);
+  requested_params_ = params_;
+  max_consecutive_rejections_ = params_.matcher.max_consecutive_rejections;
 
   min_rate_ = params_.min_rate;
   max_rate_ = params_.max_rate;
@@ -105,6 +118,8 @@ void ScanMatcherNodelet::onInit() {
   reset_srv_ = pnh.advertiseService("reset", &ScanMatcherNodelet::resetService, this);
   set_pose_srv_ = pnh.advertiseService("set_pose", &ScanMatcherNodelet::setPoseService, this);
 
+  // The worker before the reconfigure server, whose first callback posts to it.
+  worker_ = std::thread([this] { workerLoop(); });
   reconfigure_server_ =
       std::make_unique<dynamic_reconfigure::Server<ScanMatcherConfig>>(reconfigure_mutex_, pnh);
   reconfigure_server_->updateConfig(toConfig(params_));
@@ -126,58 +141,110 @@ void ScanMatcherNodelet::onInit() {
 }
 
 void ScanMatcherNodelet::reconfigure(ScanMatcherConfig& config, uint32_t /*level*/) {
-  std::lock_guard<std::mutex> lock(mutex_);
-  // Applied to a copy: a request that is invalid or whose grids cannot be built (the matcher
-  // builds the current reference with it first) leaves every setting as it was, and the reply
-  // carries the old values back.
-  NodeParams requested = params_;
+  // Checked here against the settings asked for last, applied by the worker: a request that
+  // is invalid, or whose grids cannot be built (the matcher builds the current reference with
+  // it first), leaves every setting as it was. The reply waits for the worker at most 50 ms:
+  // when it is idle a refusal carries the old values back in the reply, otherwise in a config
+  // update once the worker has tried.
+  NodeParams requested;
+  {
+    std::lock_guard<std::mutex> lock(inbox_mutex_);
+    requested = requested_params_;
+  }
   try {
     applyConfig(config, requested);
-    matcher_->setSettings(requested.matcher);
-    params_ = requested;
   } catch (const std::exception& e) {
     NODELET_WARN("dynamic_reconfigure request refused, settings unchanged: %s", e.what());
-    config = toConfig(params_);
+    config = toConfig(requested);
+    return;
   }
+  {
+    std::lock_guard<std::mutex> lock(inbox_mutex_);
+    requested_params_ = requested;
+  }
+  struct Outcome {
+    std::mutex m;
+    std::condition_variable cv;
+    bool done = false, refused = false, answered = false;
+    ScanMatcherConfig kept;
+  };
+  auto outcome = std::make_shared<Outcome>();
+  post([this, outcome, settings = requested.matcher] {
+    bool refused = false;
+    try {
+      matcher_->setSettings(settings);
+      params_.matcher = settings;
+      max_consecutive_rejections_ = settings.max_consecutive_rejections;
+    } catch (const std::exception& e) {
+      refused = true;
+      NODELET_WARN("dynamic_reconfigure request refused, settings unchanged: %s", e.what());
+      std::lock_guard<std::mutex> lock(inbox_mutex_);
+      requested_params_.matcher = params_.matcher;
+    }
+    bool answered;
+    {
+      std::lock_guard<std::mutex> lock(outcome->m);
+      outcome->done = true;
+      outcome->refused = refused;
+      outcome->kept = toConfig(params_);
+      answered = outcome->answered;
+    }
+    outcome->cv.notify_all();
+    if (refused && answered) reconfigure_server_->updateConfig(toConfig(params_));
+  });
+  std::unique_lock<std::mutex> lock(outcome->m);
+  outcome->cv.wait_for(lock, std::chrono::milliseconds(50), [&] { return outcome->done; });
+  outcome->answered = true;
+  if (outcome->done && outcome->refused) config = outcome->kept;
 }
 
 bool ScanMatcherNodelet::resetService(std_srvs::Trigger::Request&, std_srvs::Trigger::Response& res) {
-  std::lock_guard<std::mutex> lock(mutex_);
+  post([this] { applyReset(); });
+  res.success = true;
+  res.message = "the next scan starts a new chain (reference, pose chain, path and counters reset)";
+  if (params_.reset_continuous) res.message += "; it continues from the last pose";
+  return true;
+}
+
+void ScanMatcherNodelet::applyReset() {
   // Continuous: the new chain starts where the old one was, moved on by the odometry from the
   // last published scan to the next one, so that map does not jump.
   // Its covariance goes on too: the new chain is known no better than the old one's end.
   const std::optional<Eigen::Isometry3d> last_pose = last_pose_, last_odom = last_odom_;
   const std::optional<Matrix6d> last_covariance = last_covariance_;
   resetState("reset requested through the ~reset service");
-  res.success = true;
-  res.message = "reference, pose chain, path and counters reset";
   if (params_.reset_continuous && last_pose) {
     matcher_->restartAt(*last_pose);
     pending_start_ = PendingStart{*last_pose, last_odom};
     chain_->restart(last_covariance);
     anchor_->reset(last_covariance);
-    res.message += "; the new chain continues from the last pose";
   }
-  return true;
 }
 
 bool ScanMatcherNodelet::setPoseService(SetPose::Request& req, SetPose::Response& res) {
-  std::lock_guard<std::mutex> lock(mutex_);
-  const std::string refused = restartChain(req.pose, "~set_pose", false);
+  ChainStart start;
+  const std::string refused = parseStart(req.pose, "~set_pose", false, start);
   res.success = refused.empty();
   res.message = res.success ? "the next scan starts a new chain at the given pose" : refused;
-  if (!res.success) NODELET_WARN("~set_pose refused: %s", refused.c_str());
+  if (res.success) {
+    post([this, start] { restartChain(start, "~set_pose"); });
+  } else {
+    NODELET_WARN("~set_pose refused: %s", refused.c_str());
+  }
   return true;
 }
 
 void ScanMatcherNodelet::initialPoseCallback(
     const geometry_msgs::PoseWithCovarianceStampedConstPtr& msg) {
+  post([this, msg] { applyInitialPose(*msg); });
+}
+
+void ScanMatcherNodelet::applyInitialPose(const geometry_msgs::PoseWithCovarianceStamped& msg) {
   // RViz's "2D Pose Estimate" gives x, y and yaw on the ground plane (z 0, level): a 3D chain
   // keeps z, roll and pitch of its last pose (none before the first scan: 0) with their
   // variances (none before the first scan: unknown).
-  std::lock_guard<std::mutex> lock(mutex_);
-  geometry_msgs::PoseWithCovarianceStamped pose = *msg;
-  const auto& o = msg->pose.pose.orientation;
+  geometry_msgs::PoseWithCovarianceStamped pose = msg;
+  const auto& o = msg.pose.pose.orientation;
   const Eigen::Quaterniond q(o.w, o.x, o.y, o.z);
   if (q.coeffs().allFinite() && q.norm() > 0.5) {
     // Yaw of a rotation: the heading of its x axis on the ground plane (z-y-x Euler order).
@@ -196,13 +263,18 @@ void ScanMatcherNodelet::initialPoseCallback(
       if (last_covariance_) pose.pose.covariance[std::size_t(7 * i)] = (*last_covariance_)(i, i);
     }
   }
-  const std::string refused = restartChain(pose, "initialpose", true);
-  if (!refused.empty()) NODELET_WARN("initialpose refused: %s", refused.c_str());
+  ChainStart start;
+  const std::string refused = parseStart(pose, "initialpose", true, start);
+  if (refused.empty()) {
+    restartChain(start, "initialpose");
+  } else {
+    NODELET_WARN("initialpose refused: %s", refused.c_str());
+  }
 }
 
-std::string ScanMatcherNodelet::restartChain(const geometry_msgs::PoseWithCovarianceStamped& req,
-                                             const std::string& source,
-                                             bool stamp_is_approximate) {
+std::string ScanMatcherNodelet::parseStart(const geometry_msgs::PoseWithCovarianceStamped& req,
+                                           const std::string& source, bool stamp_is_approximate,
+                                           ChainStart& start) {
   const auto& p = req.pose.pose;
   const Eigen::Quaterniond q(p.orientation.w, p.orientation.x, p.orientation.y, p.orientation.z);
   const Eigen::Vector3d t(p.position.x, p.position.y, p.position.z);
@@ -213,54 +285,58 @@ std::string ScanMatcherNodelet::restartChain(const geometry_msgs::PoseWithCovari
   if (!t.allFinite() || !q.coeffs().allFinite() || std::abs(q.norm() - 1.0) > 1e-3) {
     return "pose must be finite with a unit quaternion";
   }
-  Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();
-  pose.linear() = q.normalized().toRotationMatrix();
-  pose.translation() = t;
+  start.pose = Eigen::Isometry3d::Identity();
+  start.pose.linear() = q.normalized().toRotationMatrix();
+  start.pose.translation() = t;
   // The pose holds at the request's stamp: the next scan's start is moved on by the odometry
   // from that stamp to its own (a zero stamp: the pose holds at the next scan).
-  std::optional<Eigen::Isometry3d> odom_at_stamp;
+  start.odom.reset();
   if (!req.header.stamp.isZero()) {
     std::string error;
-    odom_at_stamp = lookup(params_.odom_frame, params_.base_frame, req.header.stamp, error);
-    if (!odom_at_stamp && !stamp_is_approximate) {
+    start.odom = lookup(params_.odom_frame, params_.base_frame, req.header.stamp, error);
+    if (!start.odom && !stamp_is_approximate) {
       return "no odometry at the pose's stamp " + std::to_string(req.header.stamp.toSec()) +
              " s (" + error + "); send it with a zero stamp to start the next scan there";
     }
-    if (!odom_at_stamp) {
+    if (!start.odom) {
       NODELET_INFO("%s: no odometry at its stamp %.3f s (%s): the pose holds at the next scan",
                    source.c_str(), req.header.stamp.toSec(), error.c_str());
     }
   }
-  resetState("pose set through " + source);
-  matcher_->restartAt(pose);
-  pending_start_ = PendingStart{pose, odom_at_stamp};
   // The request's covariance; a variance it leaves at 0 (unknown) becomes the one of a scan
   // whose registration was rejected (rejected_sigma_m, rejected_sigma_deg): loose, not the
   // floors of a registration.
   const auto& c = req.pose.covariance;
-  Matrix6d start = Matrix6d::Zero();
   for (int i = 0; i < 6; ++i) {
-    for (int j = 0; j < 6; ++j) start(i, j) = c[std::size_t(6 * i + j)];
+    for (int j = 0; j < 6; ++j) start.covariance(i, j) = c[std::size_t(6 * i + j)];
   }
-  start = 0.5 * (start + start.transpose());
-  const ChainCovarianceSettings& cs = chain_->settings();
+  start.covariance = 0.5 * (start.covariance + start.covariance.transpose());
+  const ChainCovarianceSettings& cs = params_.chain;
   const Matrix6d unknown = diagonalCovariance(cs.rejected_sigma_m, cs.rejected_sigma_rad);
   for (int i = 0; i < 6; ++i) {
-    if (!(start(i, i) > 0.0)) start(i, i) = unknown(i, i);
+    if (!(start.covariance(i, i) > 0.0)) start.covariance(i, i) = unknown(i, i);
   }
-  chain_->restart(start);
-  anchor_->reset(start);
   return "";
+}
+
+void ScanMatcherNodelet::restartChain(const ChainStart& start, const std::string& source) {
+  resetState("pose set through " + source);
+  matcher_->restartAt(start.pose);
+  pending_start_ = PendingStart{start.pose, start.odom};
+  chain_->restart(start.covariance);
+  anchor_->reset(start.covariance);
 }
 
 void ScanMatcherNodelet::resetState(const std::string& why) {
   NODELET_WARN("%s: the next scan starts a new pose chain", why.c_str());
   if (matcher_) matcher_->reset();
   path_.poses.clear();
-  last_seq_.reset();
   last_stamp_.reset();
   dropped_ = rejected_ = tf_failures_ = processed_ = bad_input_ = consecutive_rejections_ = 0;
-  latencies_.clear();
+  {
+    std::lock_guard<std::mutex> lock(stats_mutex_);
+    latencies_.clear();
+  }
   if (chain_) chain_->restart(std::nullopt);
   if (anchor_) anchor_->reset(std::nullopt);
   pending_start_.reset();
@@ -289,11 +365,57 @@ std::optional<Eigen::Isometry3d> ScanMatcherNodelet::lookup(const std::string& t
 void ScanMatcherNodelet::cloudCallback(const sensor_msgs::PointCloud2ConstPtr& msg) {
   const double received = ros::WallTime::now().toSec();
   if (!initialised_) return;
-  std::lock_guard<std::mutex> lock(mutex_);
-  try {
-    processCloud(*msg, received);
-  } catch (const std::exception& e) {
-    NODELET_ERROR_THROTTLE(5.0, "scan %u not processed: %s", msg->header.seq, e.what());
+  countArrival(*msg);
+  bool overwritten;
+  {
+    std::lock_guard<std::mutex> lock(inbox_mutex_);
+    overwritten = inbox_ != nullptr;
+    inbox_ = msg;
+    inbox_received_ = received;
+  }
+  inbox_cv_.notify_one();
+  if (overwritten) {
+    ++dropped_;
+    NODELET_WARN_THROTTLE(5.0, "a scan was dropped: a newer one arrived while the registration "
+                               "before it ran (%u dropped)", dropped_.load());
+  }
+}
+
+void ScanMatcherNodelet::post(std::function<void()> change) {
+  {
+    std::lock_guard<std::mutex> lock(inbox_mutex_);
+    changes_.push_back(std::move(change));
+  }
+  inbox_cv_.notify_one();
+}
+
+void ScanMatcherNodelet::workerLoop() {
+  for (;;) {
+    sensor_msgs::PointCloud2ConstPtr msg;
+    double received = 0.0;
+    std::deque<std::function<void()>> changes;
+    {
+      std::unique_lock<std::mutex> lock(inbox_mutex_);
+      inbox_cv_.wait(lock, [this] { return stopping_ || inbox_ || !changes_.empty(); });
+      if (stopping_) return;
+      changes.swap(changes_);
+      msg.swap(inbox_);
+      received = inbox_received_;
+    }
+    // Nothing may leave this thread: an exception here would end the manager's process.
+    for (auto& change : changes) {
+      try {
+        change();
+      } catch (const std::exception& e) {
+        NODELET_ERROR("a change to the matcher's state failed: %s", e.what());
+      }
+    }
+    if (!msg) continue;
+    try {
+      processCloud(*msg, received);
+    } catch (const std::exception& e) {
+      NODELET_ERROR_THROTTLE(5.0, "scan %u not processed: %s", msg->header.seq, e.what());
+    }
   }
 }
 
@@ -306,7 +428,6 @@ void ScanMatcherNodelet::processCloud(const sensor_msgs::PointCloud2& msg, doubl
   status.points_in = msg.width * msg.height;
   Scan scan(msg, received, status);
 
-  countArrival(scan);
   if (!checkHeader(scan)) return;
   trackStamps(scan);
   if (!lookupFrames(scan)) return;
@@ -335,8 +456,11 @@ void ScanMatcherNodelet::publishStatus(Scan& scan, GateReason reason,
   status.consecutive_rejections = consecutive_rejections_;
   status.latency = ros::WallTime::now().toSec() - scan.received;
   status.data_age = (ros::Time::now() - scan.msg.header.stamp).toSec();
-  latencies_.push_back(status.latency);
-  if (latencies_.size() > 200) latencies_.pop_front();
+  {
+    std::lock_guard<std::mutex> lock(stats_mutex_);
+    latencies_.push_back(status.latency);
+    if (latencies_.size() > 200) latencies_.pop_front();
+  }
   status_pub_.publish(status);
 }
 
@@ -365,10 +489,11 @@ void ScanMatcherNodelet::trackStamps(Scan& scan) {
   last_stamp_ = stamp;
 }
 
-void ScanMatcherNodelet::countArrival(Scan& scan) {
+void ScanMatcherNodelet::countArrival(const sensor_msgs::PointCloud2& msg) {
   // Scans the subscriber queue dropped never reach this callback: they are counted from the
-  // header.seq gap, as drops and as arrivals of the input rate.
-  const std::uint32_t seq = scan.msg.header.seq;
+  // header.seq gap, as drops and as arrivals of the input rate. (A publisher in the same
+  // manager hands its message over without a seq: such drops are not seen here.)
+  const std::uint32_t seq = msg.header.seq;
   std::uint32_t gap = 0;
   if (last_seq_ && seq > *last_seq_ + 1) gap = std::min<std::uint32_t>(seq - *last_seq_ - 1, 10000);
   last_seq_ = seq;
@@ -623,25 +748,31 @@ void ScanMatcherNodelet::diagnose(diagnostic_updater::DiagnosticStatusWrapper& s
     stat.summary(DiagnosticStatus::ERROR, "not running: " + init_error_);
     return;
   }
-  std::lock_guard<std::mutex> lock(mutex_);
-  const std::vector<double> latencies(latencies_.begin(), latencies_.end());
+  std::vector<double> latencies;
+  {
+    std::lock_guard<std::mutex> lock(stats_mutex_);
+    latencies.assign(latencies_.begin(), latencies_.end());
+  }
   const double median = quantile(latencies, 0.5), p95 = quantile(latencies, 0.95);
-  stat.add("scans processed", processed_);
-  stat.add("scans rejected", rejected_);
-  stat.add("consecutive rejections", consecutive_rejections_);
-  stat.add("tf failures", tf_failures_);
-  stat.add("bad input scans", bad_input_);
-  stat.add("dropped scans", dropped_);
+  const std::uint32_t processed = processed_, rejected = rejected_, tf_failures = tf_failures_;
+  const std::uint32_t bad_input = bad_input_, dropped = dropped_;
+  const std::uint32_t consecutive = consecutive_rejections_;
+  stat.add("scans processed", processed);
+  stat.add("scans rejected", rejected);
+  stat.add("consecutive rejections", consecutive);
+  stat.add("tf failures", tf_failures);
+  stat.add("bad input scans", bad_input);
+  stat.add("dropped scans", dropped);
   stat.add("latency median [s]", median);
   stat.add("latency p95 [s]", p95);
-  if (matcher_ && consecutive_rejections_ >= std::uint32_t(params_.matcher.max_consecutive_rejections)) {
+  if (consecutive >= std::uint32_t(max_consecutive_rejections_.load())) {
     stat.summary(DiagnosticStatus::ERROR, "consecutive rejections: poses follow odometry only");
   } else if (median > params_.max_latency) {
     stat.summary(DiagnosticStatus::WARN, "latency above max_latency");
-  } else if (rejected_ > 0 || tf_failures_ > 0 || dropped_ > 0 || bad_input_ > 0) {
+  } else if (rejected > 0 || tf_failures > 0 || dropped > 0 || bad_input > 0) {
     stat.summary(DiagnosticStatus::WARN, "some scans rejected, dropped or without tf");
   } else {
-    stat.summary(DiagnosticStatus::OK, processed_ ? "registering" : "waiting for scans");
+    stat.summary(DiagnosticStatus::OK, processed ? "registering" : "waiting for scans");
   }
 }
 

@@ -17,6 +17,7 @@
 #include <utility>
 
 #include <diagnostic_msgs/DiagnosticArray.h>
+#include <dynamic_reconfigure/Config.h>
 #include <dynamic_reconfigure/Reconfigure.h>
 #include <sensor_msgs/point_cloud2_iterator.h>
 #include <std_srvs/Trigger.h>
@@ -446,17 +447,31 @@ TEST_F(Faults, SensorExtrinsicChangeOnTfIsFollowed) {
 }
 
 // A live cube_edge of 0.01 m (clamped to the cfg's 0.05 m by dynamic_reconfigure) would give
-// refine grids far beyond max_grid_megabytes: the request is refused, the reply carries the
-// old value back, and registration goes on.
+// refine grids far beyond max_grid_megabytes: the request is refused, the old value comes back
+// (in the reply when the worker answers within its 50 ms, else in a config update), and
+// registration goes on.
 TEST_F(Faults, LiveCubeEdgeWhoseGridsCannotBeBuiltIsRefused) {
   Status before;
   for (int k = 0; k < 2; ++k) {
     before = sendSweep(k, stampOf(k));
     EXPECT_EQ(before.reason, k == 0 ? Status::FIRST_SCAN : Status::ACCEPTED);
   }
+  std::vector<double> updates_seen;  // cube_edge of every config update, in order
+  ros::Subscriber updates = nh.subscribe<dynamic_reconfigure::Config>(
+      kNs + "parameter_updates", 10, [&](const dynamic_reconfigure::Config::ConstPtr& c) {
+        for (const auto& d : c->doubles) {
+          if (d.name == "cube_edge") updates_seen.push_back(d.value);
+        }
+      });
+  ASSERT_TRUE(waitFor([&] { return !updates_seen.empty(); }, 5.0));  // latched: the current one
+  updates_seen.clear();
   double replied = -1.0;
   ASSERT_TRUE(setParameters(0.01, 0, 0, &replied));
-  EXPECT_EQ(replied, 0.5);
+  if (replied != 0.5) {
+    // The reply took the request (0.05); the refusal follows as an update back to 0.5.
+    EXPECT_TRUE(waitFor([&] { return updates_seen.size() >= 2 && updates_seen.back() == 0.5; }, 10.0))
+        << "neither the reply (" << replied << ") nor a config update carried 0.5 back";
+  }
   for (int k = 2; k < 4; ++k) {
     const Status s = sendSweep(k, stampOf(k));
     EXPECT_EQ(s.reason, Status::ACCEPTED) << s.message;

@@ -19,11 +19,13 @@
 #include <sensor_msgs/point_cloud2_iterator.h>
 #include <std_srvs/Trigger.h>
 #include <tf2_eigen/tf2_eigen.h>
+#include <tf2_msgs/TFMessage.h>
 #include <tf2_ros/buffer.h>
 #include <tf2_ros/static_transform_broadcaster.h>
 #include <tf2_ros/transform_broadcaster.h>
 #include <tf2_ros/transform_listener.h>
 
+#include "cube_scan_matcher/SetPose.h"
 #include "cube_scan_matcher/Status.h"
 #include "cube_scan_matcher/core/pose.h"
 #include "cube_scan_matcher/core/pose_covariance.h"
@@ -564,6 +566,100 @@ TEST(ScanMatcherBadParam, RefusesToStartAndNamesTheParameter) {
   ros::param::get("~manager_node", manager);
   EXPECT_NE(std::find(nodes.begin(), nodes.end(), manager), nodes.end()) << manager << " went down";
   EXPECT_FALSE(ros::service::exists(kNs + "reset", false));
+}
+
+/// The matcher with search settings that make one registration last seconds
+/// (test/ros/slow_registration.test).
+class ScanMatcherSlow : public ScanMatcherRos {};
+
+// While a registration runs, the nodelet still answers: a service within 100 ms, diagnostics
+// every second, map -> odom at tf_rate; clouds that arrive meanwhile are not queued behind it
+// (the newest waits in the mailbox, older ones are dropped and counted).
+TEST_F(ScanMatcherSlow, ServicesDiagnosticsAndTfAnswerWhileARegistrationRuns) {
+  std::vector<double> diagnostics_at, map_odom_at;  // wall times of arrival [s]
+  ros::Subscriber diag_sub = nh.subscribe<diagnostic_msgs::DiagnosticArray>(
+      "/diagnostics", 10, [&](const diagnostic_msgs::DiagnosticArray::ConstPtr& m) {
+        for (const auto& d : m->status) {
+          if (d.name.find("registration") != std::string::npos) {
+            diagnostics_at.push_back(ros::WallTime::now().toSec());
+          }
+        }
+      });
+  ros::Subscriber tf_sub = nh.subscribe<tf2_msgs::TFMessage>(
+      "/tf", 100, [&](const tf2_msgs::TFMessage::ConstPtr& m) {
+        for (const auto& t : m->transforms) {
+          if (t.header.frame_id == "map" && t.child_frame_id == "odom") {
+            map_odom_at.push_back(ros::WallTime::now().toSec());
+          }
+        }
+      });
+  double tf_rate = 0.0;
+  ASSERT_TRUE(ros::param::get(kNs + "tf_rate", tf_rate));
+  const sim::Scene scene = sim::Scene::generate(sim::SceneType::Urban, 3);
+  std::mt19937_64 rng(31);
+  Eigen::Isometry3d body = Eigen::Isometry3d::Identity();
+  body.translation() = Eigen::Vector3d(0, 0, scene.groundHeight(0, 0) + 0.5);
+  ros::Time stamp = ros::Time::now();
+  auto cloudAt = [&](double ahead) {
+    body.translation().x() += ahead;
+    stamp += ros::Duration(0.5);
+    tf_pub.sendTransform(stampedTransform(body, "odom", "base_link", stamp));
+    return makeCloud(sweepInBase(scene, body, rng), "base_link", stamp);
+  };
+  EXPECT_EQ(send(cloudAt(0.0)).reason, Status::FIRST_SCAN);  // no registration: quick
+
+  // The second scan's registration, and while it runs:
+  const sensor_msgs::PointCloud2 second = cloudAt(0.5);
+  spinFor(0.1);  // its tf first
+  cloud_pub.publish(second);
+  const double started = ros::WallTime::now().toSec();
+  spinFor(0.3);
+  ASSERT_EQ(out.statusAt(second.header.stamp), nullptr)
+      << "the registration ended within 0.3 s: slow_registration.test's settings no longer "
+         "make it slow, and this test would show nothing";
+  // ... a service answers (a refused ~set_pose: it leaves the chain as it is),
+  SetPose refused;
+  refused.request.pose.header.frame_id = "not_the_map";
+  refused.request.pose.pose.pose.orientation.w = 1.0;
+  const double called = ros::WallTime::now().toSec();
+  ASSERT_TRUE(ros::service::call(kNs + "set_pose", refused));
+  const double answered = ros::WallTime::now().toSec();
+  EXPECT_FALSE(refused.response.success);
+  EXPECT_LT(answered - called, 0.1) << "~set_pose took " << answered - called << " s";
+  // ... two more clouds arrive: the first is dropped when the second takes its place.
+  const sensor_msgs::PointCloud2 third = cloudAt(0.5);
+  spinFor(0.1);
+  cloud_pub.publish(third);
+  spinFor(0.1);
+  const sensor_msgs::PointCloud2 fourth = cloudAt(0.5);
+  spinFor(0.1);
+  cloud_pub.publish(fourth);
+  ASSERT_TRUE(waitFor([&] { return out.statusAt(second.header.stamp) != nullptr; }, 300.0));
+  const double ended = ros::WallTime::now().toSec();
+  ASSERT_GT(ended - started, 2.0) << "the registration took " << ended - started
+                                  << " s: too short to see diagnostics and tf go on";
+  EXPECT_EQ(out.statusAt(second.header.stamp)->reason, Status::ACCEPTED);
+  ASSERT_TRUE(waitFor([&] { return out.statusAt(fourth.header.stamp) != nullptr; }, 300.0));
+  EXPECT_EQ(out.statusAt(third.header.stamp), nullptr) << "the dropped cloud was registered";
+  EXPECT_EQ(out.statusAt(fourth.header.stamp)->dropped_scans, 1u);
+
+  // Diagnostics (every 1 s) and map -> odom (every 1 / tf_rate s) went on during it.
+  auto largestGap = [&](const std::vector<double>& at) {
+    double last = started, gap = 0.0;
+    for (const double t : at) {
+      if (t < started || t > ended) continue;
+      gap = std::max(gap, t - last);
+      last = t;
+    }
+    return std::max(gap, ended - last);
+  };
+  EXPECT_LT(largestGap(diagnostics_at), 1.6) << "diagnostics stopped during the registration";
+  EXPECT_LT(largestGap(map_odom_at), 0.5) << "map -> odom stopped during the registration (tf_rate "
+                                          << tf_rate << " Hz)";
+  std::printf("[slow] registration %.2f s; ~set_pose answered in %.3f s; largest gaps: "
+              "diagnostics %.2f s, map -> odom %.3f s\n",
+              ended - started, answered - called, largestGap(diagnostics_at),
+              largestGap(map_odom_at));
 }
 
 }  // namespace

@@ -4,12 +4,24 @@
 // registered cloud, status, optional tf and diagnostics; it also owns the services, dynamic
 // reconfigure and the handling of stamps going backwards. Topics and frames: README.md;
 // parameters: docs/parameters.md.
+//
+// Threads: the registration runs on the nodelet's own worker thread, never on a manager
+// thread. The cloud callback only puts the newest cloud into a one-slot mailbox (latest wins:
+// a cloud still waiting there when a newer one arrives is dropped and counted). ~reset,
+// ~set_pose, initialpose and dynamic_reconfigure answer at once and hand their change to the
+// worker, which applies it before the next scan. map -> odom is sent from the manager's
+// multi-threaded queue, diagnostics read counters of their own: neither waits for a
+// registration.
 #pragma once
 
+#include <atomic>
+#include <condition_variable>
 #include <deque>
+#include <functional>
 #include <memory>
 #include <mutex>
 #include <optional>
+#include <thread>
 #include <utility>
 
 #include <diagnostic_updater/diagnostic_updater.h>
@@ -44,8 +56,13 @@ class ScanMatcherNodelet : public nodelet::Nodelet {
 
  private:
   void onInit() override;
+  /// Counts the arrival and puts `msg` into the mailbox; returns at once.
   void cloudCallback(const sensor_msgs::PointCloud2ConstPtr& msg);
-  /// The work of cloudCallback, under the state mutex; may throw. Its steps, in order:
+  /// The worker thread: runs the posted changes, then registers the mailbox's cloud.
+  void workerLoop();
+  /// Runs `change` on the worker thread before its next scan.
+  void post(std::function<void()> change);
+  /// The work on one cloud, on the worker thread; may throw. Its steps, in order:
   void processCloud(const sensor_msgs::PointCloud2& msg, double received_wall);
   /// One scan on its way through processCloud.
   struct Scan {
@@ -59,7 +76,8 @@ class ScanMatcherNodelet : public nodelet::Nodelet {
     std::optional<PointTimes> times;        ///< their times, from the cloud's time_field
     std::optional<std::vector<float>> intensity;  ///< their "intensity" field, if the cloud has one
   };
-  void countArrival(Scan& scan);    ///< input rate and dropped scans (header.seq gaps)
+  /// Input rate and scans dropped before the callback (header.seq gaps; manager thread).
+  void countArrival(const sensor_msgs::PointCloud2& msg);
   bool checkHeader(Scan& scan);     ///< a stamp and a frame
   void trackStamps(Scan& scan);     ///< time going backwards (reset)
   bool lookupFrames(Scan& scan);    ///< cloud -> base_frame and odometry at the stamp
@@ -73,12 +91,26 @@ class ScanMatcherNodelet : public nodelet::Nodelet {
   bool setPoseService(SetPose::Request& req, SetPose::Response& res);
   /// RViz's "2D Pose Estimate" (topic initialpose): x, y and yaw restart the chain.
   void initialPoseCallback(const geometry_msgs::PoseWithCovarianceStampedConstPtr& msg);
-  /// ~set_pose and initialpose: the next scan starts a new chain at `pose` (map_frame); the
-  /// reason it was refused, or empty. With `stamp_is_approximate` (a pose clicked in RViz,
-  /// stamped with its clock) a stamp the odometry cannot be looked up at means "now": the pose
-  /// holds at the next scan.
-  std::string restartChain(const geometry_msgs::PoseWithCovarianceStamped& pose,
-                           const std::string& source, bool stamp_is_approximate);
+  /// A new chain's start: the pose (T_map_base), the odometry when it held (none: it holds
+  /// at the next scan as it is) and its covariance [m², rad²].
+  struct ChainStart {
+    Eigen::Isometry3d pose;
+    std::optional<Eigen::Isometry3d> odom;
+    Matrix6d covariance;
+  };
+  /// ~set_pose and initialpose: `start` set from `pose` (map_frame), or the reason it is
+  /// refused. With `stamp_is_approximate` (a pose clicked in RViz, stamped with its clock) a
+  /// stamp the odometry cannot be looked up at means "now": the pose holds at the next scan.
+  /// Reads no worker state: runs on any thread.
+  std::string parseStart(const geometry_msgs::PoseWithCovarianceStamped& pose,
+                         const std::string& source, bool stamp_is_approximate,
+                         ChainStart& start);
+  /// Worker thread: the next scan starts a new chain at `start`.
+  void restartChain(const ChainStart& start, const std::string& source);
+  /// Worker thread: initialpose merged with the last pose's z, roll and pitch, then restarted.
+  void applyInitialPose(const geometry_msgs::PoseWithCovarianceStamped& msg);
+  /// Worker thread: ~reset (continuous or not).
+  void applyReset();
   void reconfigure(ScanMatcherConfig& config, uint32_t level);
   /// T_target_source at `stamp`, waiting at most ~tf_timeout; nullopt (and counted) on failure.
   std::optional<Eigen::Isometry3d> lookup(const std::string& target, const std::string& source,
@@ -88,9 +120,21 @@ class ScanMatcherNodelet : public nodelet::Nodelet {
 
   // First member, so destroyed last: every handle below goes while its queue still lives.
   NodeletQueues queues_;
+  // Written by onInit, then only its matcher settings, by the worker (a reconfigure): other
+  // threads read the frames, timeouts and the like, never params_.matcher.
   NodeParams params_;
   std::unique_ptr<OnlineMatcher> matcher_;
-  std::mutex mutex_;  // guards everything below: callbacks may run on several manager threads
+
+  // The mailbox and the posted changes, handed from callbacks to the worker.
+  std::mutex inbox_mutex_;
+  std::condition_variable inbox_cv_;
+  sensor_msgs::PointCloud2ConstPtr inbox_;  // the newest cloud not yet taken
+  double inbox_received_ = 0.0;             // its arrival [s, wall]
+  std::deque<std::function<void()>> changes_;
+  bool stopping_ = false;
+  // The settings the last accepted reconfigure asked for (applied or about to be).
+  NodeParams requested_params_;
+  std::thread worker_;
 
   std::unique_ptr<tf2_ros::Buffer> tf_buffer_;
   std::unique_ptr<tf2_ros::TransformListener> tf_listener_;
@@ -129,12 +173,16 @@ class ScanMatcherNodelet : public nodelet::Nodelet {
   std::optional<PendingStart> pending_start_;
 
   nav_msgs::Path path_;
-  std::optional<std::uint32_t> last_seq_;
   std::optional<ros::Time> last_stamp_;
-  std::uint32_t dropped_ = 0, rejected_ = 0, tf_failures_ = 0, processed_ = 0;
-  std::uint32_t bad_input_ = 0, consecutive_rejections_ = 0;
-  std::deque<double> latencies_;  // last latencies [s], for diagnostics
-  bool initialised_ = false;
+  std::optional<std::uint32_t> last_seq_;  // the manager thread's (countArrival)
+
+  // Counters: written by the worker (dropped_ also by the callback), read by diagnostics.
+  std::atomic<std::uint32_t> dropped_{0}, rejected_{0}, tf_failures_{0}, processed_{0};
+  std::atomic<std::uint32_t> bad_input_{0}, consecutive_rejections_{0};
+  std::atomic<int> max_consecutive_rejections_{0};  // params_.matcher's, for diagnostics
+  std::mutex stats_mutex_;
+  std::deque<double> latencies_;  // last latencies [s], for diagnostics (stats_mutex_)
+  std::atomic<bool> initialised_{false};
   std::string init_error_;
 };
 
