@@ -164,6 +164,7 @@ NodeParams loadParams(const ros::NodeHandle& pnh) {
     throw ParamError("parameter ~map_frame must differ from ~odom_frame and ~base_frame");
   }
   p.tf_timeout = readParam(pnh, "tf_timeout", p.tf_timeout, 0.0, 10.0, "s");
+  p.time_jump_reset = readParam(pnh, "time_jump_reset", p.time_jump_reset, 0.0, 3600.0, "s");
   const std::string policy = getString(pnh, "missing_tf_policy", "identity");
   if (policy != "identity" && policy != "skip") {
     throw ParamError("parameter ~missing_tf_policy = '" + policy + "' must be identity or skip");

@@ -118,7 +118,9 @@ void ScanMatcherNodelet::onInit() {
   reset_srv_ = pnh.advertiseService("reset", &ScanMatcherNodelet::resetService, this);
   set_pose_srv_ = pnh.advertiseService("set_pose", &ScanMatcherNodelet::setPoseService, this);
 
-  // The worker before the reconfigure server, whose first callback posts to it.
+  // The worker before the reconfigure server, whose first callback posts to it. From here on
+  // params_.matcher is the worker's.
+  const double cube_edge = params_.matcher.registration.grid.cube_edge;
   worker_ = std::thread([this] { workerLoop(); });
   reconfigure_server_ =
       std::make_unique<dynamic_reconfigure::Server<ScanMatcherConfig>>(reconfigure_mutex_, pnh);
@@ -136,8 +138,7 @@ void ScanMatcherNodelet::onInit() {
       "ScanMatcherNodelet: registering %s in %s (odometry %s, poses in %s), E = %.2f m, "
       "SIMD path %s",
       cloud_sub_.getTopic().c_str(), params_.base_frame.c_str(), params_.odom_frame.c_str(),
-      params_.map_frame.c_str(), params_.matcher.registration.grid.cube_edge,
-      simdReport().c_str());
+      params_.map_frame.c_str(), cube_edge, simdReport().c_str());
 }
 
 void ScanMatcherNodelet::reconfigure(ScanMatcherConfig& config, uint32_t /*level*/) {
@@ -162,14 +163,13 @@ void ScanMatcherNodelet::reconfigure(ScanMatcherConfig& config, uint32_t /*level
     std::lock_guard<std::mutex> lock(inbox_mutex_);
     requested_params_ = requested;
   }
-  struct Outcome {
-    std::mutex m;
-    std::condition_variable cv;
-    bool done = false, refused = false, answered = false;
-    ScanMatcherConfig kept;
-  };
-  auto outcome = std::make_shared<Outcome>();
-  post([this, outcome, settings = requested.matcher] {
+  std::uint64_t id;
+  {
+    std::lock_guard<std::mutex> lock(inbox_mutex_);
+    id = ++reconfigure_asked_;
+    reconfigure_waiting_ = id;
+  }
+  post([this, id, settings = requested.matcher] {
     bool refused = false;
     try {
       matcher_->setSettings(settings);
@@ -178,24 +178,24 @@ void ScanMatcherNodelet::reconfigure(ScanMatcherConfig& config, uint32_t /*level
     } catch (const std::exception& e) {
       refused = true;
       NODELET_WARN("dynamic_reconfigure request refused, settings unchanged: %s", e.what());
-      std::lock_guard<std::mutex> lock(inbox_mutex_);
-      requested_params_.matcher = params_.matcher;
     }
-    bool answered;
+    bool late;
     {
-      std::lock_guard<std::mutex> lock(outcome->m);
-      outcome->done = true;
-      outcome->refused = refused;
-      outcome->kept = toConfig(params_);
-      answered = outcome->answered;
+      std::lock_guard<std::mutex> lock(inbox_mutex_);
+      if (refused) requested_params_.matcher = params_.matcher;
+      late = reconfigure_waiting_ != id;  // the reply has gone out with the request's values
+      reconfigure_answered_ = id;
+      reconfigure_refused_ = refused;
+      reconfigure_kept_ = toConfig(params_);
     }
-    outcome->cv.notify_all();
-    if (refused && answered) reconfigure_server_->updateConfig(toConfig(params_));
+    reconfigure_cv_.notify_all();
+    if (refused && late) reconfigure_server_->updateConfig(toConfig(params_));
   });
-  std::unique_lock<std::mutex> lock(outcome->m);
-  outcome->cv.wait_for(lock, std::chrono::milliseconds(50), [&] { return outcome->done; });
-  outcome->answered = true;
-  if (outcome->done && outcome->refused) config = outcome->kept;
+  std::unique_lock<std::mutex> lock(inbox_mutex_);
+  reconfigure_cv_.wait_for(lock, std::chrono::milliseconds(50),
+                           [&] { return reconfigure_answered_ == id; });
+  reconfigure_waiting_ = 0;
+  if (reconfigure_answered_ == id && reconfigure_refused_) config = reconfigure_kept_;
 }
 
 bool ScanMatcherNodelet::resetService(std_srvs::Trigger::Request&, std_srvs::Trigger::Response& res) {
@@ -429,7 +429,7 @@ void ScanMatcherNodelet::processCloud(const sensor_msgs::PointCloud2& msg, doubl
   Scan scan(msg, received, status);
 
   if (!checkHeader(scan)) return;
-  trackStamps(scan);
+  if (!trackStamps(scan)) return;
   if (!lookupFrames(scan)) return;
   if (!convertPoints(scan)) return;
   const OnlineStep step = registerScan(scan);
@@ -476,17 +476,30 @@ bool ScanMatcherNodelet::checkHeader(Scan& scan) {
   return true;
 }
 
-void ScanMatcherNodelet::trackStamps(Scan& scan) {
+bool ScanMatcherNodelet::trackStamps(Scan& scan) {
   const ros::Time stamp = scan.msg.header.stamp;
-  // Time going backwards: a looping bag or a reset clock. One warning, then a fresh start.
   if (last_stamp_ && stamp < *last_stamp_) {
+    const double back = (*last_stamp_ - stamp).toSec();
     std::ostringstream os;
-    os << std::fixed << std::setprecision(3) << "time went backwards from "
-       << last_stamp_->toSec() << " s to " << stamp.toSec() << " s (bag loop or clock reset)";
+    os << std::fixed << std::setprecision(3);
+    if (back <= params_.time_jump_reset) {
+      // Out of order by a little (a driver's or a bag's reordering): not a new chain.
+      ++dropped_;
+      os << "stamp " << stamp.toSec() << " s is " << back << " s before the last scan's "
+         << last_stamp_->toSec() << " s (out of order, within time_jump_reset "
+         << params_.time_jump_reset << " s): dropped";
+      NODELET_WARN_THROTTLE(5.0, "%s", os.str().c_str());
+      publishStatus(scan, GateReason::BadInput, os.str());
+      return false;
+    }
+    // Time went back: a looping bag or a reset clock. One warning, then a fresh start.
+    os << "time went backwards from " << last_stamp_->toSec() << " s to " << stamp.toSec()
+       << " s (bag loop or clock reset)";
     resetState(os.str());
     scan.status.time_reset = true;
   }
   last_stamp_ = stamp;
+  return true;
 }
 
 void ScanMatcherNodelet::countArrival(const sensor_msgs::PointCloud2& msg) {

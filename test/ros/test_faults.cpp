@@ -626,6 +626,21 @@ TEST(SweepEvaluatorAcrossDrops, ADroppedSweepDoesNotStopTheRows) {
   EXPECT_LT(evaluator.rows()[2].inc_es, 1e-9);  // 0 -> 2 against the truth 0 -> 2
 }
 
+// A scan stamped a little before the last one (out of order, within time_jump_reset) is
+// dropped and counted, not taken for a bag loop: the chain goes on.
+TEST_F(Faults, ScanSlightlyOutOfOrderIsDroppedNotAReset) {
+  for (int k = 0; k < 2; ++k) sendSweep(k, stampOf(k));
+  const Status before = *out.statusAt(stampOf(1));
+  Status s = sendSweep(1, stampOf(1) - ros::Duration(0.05));
+  EXPECT_FALSE(s.time_reset);
+  EXPECT_EQ(s.reason, Status::BAD_INPUT) << s.message;
+  EXPECT_NE(s.message.find("out of order"), std::string::npos) << s.message;
+  EXPECT_EQ(s.dropped_scans, before.dropped_scans + 1);
+  s = sendSweep(2, stampOf(2));
+  EXPECT_EQ(s.reason, Status::ACCEPTED) << s.message;  // the same chain, not a new one
+  expectPose(2, stampOf(2));
+}
+
 // Last: the stamps jump back into the past of the other tests.
 TEST_F(Faults, ClockJumpsForwardAndBackward) {
   for (int k = 0; k < 2; ++k) sendSweep(k, stampOf(k));

@@ -23,6 +23,9 @@ struct NodeParams {
   std::string map_frame = "map";         ///< frame of the published poses and clouds.
   // tf.
   double tf_timeout = 0.1;        ///< [s] bounded wait for each tf lookup, in [0, 10].
+  /// [s] a scan stamped earlier than the last one by less than this is out of order: dropped
+  /// and counted; by more, time went back (bag loop, clock reset) and the state is reset.
+  double time_jump_reset = 1.0;
   bool skip_without_tf = false;   ///< missing_tf_policy: "skip" (true) or "identity" (false).
   /// What the node is in a REP-105 tree (README "Using it on a robot"):
   ///  - Messages: pose, odometry and path only, no tf: a filter (robot_localization) fuses them;

@@ -79,7 +79,7 @@ class ScanMatcherNodelet : public nodelet::Nodelet {
   /// Input rate and scans dropped before the callback (header.seq gaps; manager thread).
   void countArrival(const sensor_msgs::PointCloud2& msg);
   bool checkHeader(Scan& scan);     ///< a stamp and a frame
-  void trackStamps(Scan& scan);     ///< time going backwards (reset)
+  bool trackStamps(Scan& scan);     ///< out of order (dropped) or time going back (reset)
   bool lookupFrames(Scan& scan);    ///< cloud -> base_frame and odometry at the stamp
   bool convertPoints(Scan& scan);   ///< PointCloud2 -> filtered points in base_frame
   OnlineStep registerScan(Scan& scan);  ///< the core: register, gate, chain
@@ -132,8 +132,13 @@ class ScanMatcherNodelet : public nodelet::Nodelet {
   double inbox_received_ = 0.0;             // its arrival [s, wall]
   std::deque<std::function<void()>> changes_;
   bool stopping_ = false;
-  // The settings the last accepted reconfigure asked for (applied or about to be).
+  // The settings the last accepted reconfigure asked for (applied or about to be), and the
+  // worker's answer to the request the reconfigure callback waits for (inbox_mutex_).
   NodeParams requested_params_;
+  std::condition_variable reconfigure_cv_;
+  std::uint64_t reconfigure_asked_ = 0, reconfigure_waiting_ = 0, reconfigure_answered_ = 0;
+  bool reconfigure_refused_ = false;
+  ScanMatcherConfig reconfigure_kept_;
   std::thread worker_;
 
   std::unique_ptr<tf2_ros::Buffer> tf_buffer_;
