@@ -75,7 +75,8 @@ void ScanMatcherNodelet::onInit() {
   updater_->setHardwareID("none");
   updater_->add("registration", this, &ScanMatcherNodelet::diagnose);
   // force_update: update() publishes only once its own period has passed since the last
-  // time, so a timer tick that comes a little early is skipped (a 2 s gap).
+  // time (ROS time), so a timer tick that comes a little early is skipped (a 2 s gap), and
+  // after a bag loop it stays silent until the clock is back where it was.
   diagnostics_timer_ = nh.createTimer(ros::Duration(1.0), [this](const ros::TimerEvent&) {
     updater_->force_update();
   });
@@ -729,17 +730,13 @@ void ScanMatcherNodelet::publishPose(const Scan& scan, const OnlineStep& step) {
 
   if (tf_broadcaster_ && scan.odom) {
     // REP-105: map -> odom such that map -> odom -> base_link equals the registered pose.
-    bool first;
     const Eigen::Isometry3d map_odom = published * scan.odom->inverse();
     {
       std::lock_guard<std::mutex> lock(tf_mutex_);
-      first = !map_odom_;
+      const bool first = !map_odom_;
       map_odom_ = map_odom;
-    }
-    // The first one also at the scan's stamp: valid from there, not only from now + tolerance.
-    if (first) {
-      tf_broadcaster_->sendTransform(stampedTransform(map_odom, params_.map_frame,
-                                                      params_.odom_frame, header.stamp));
+      // The first one also at the scan's stamp: valid from there, not only from now + tolerance.
+      if (first) sendMapOdomAt(header.stamp);
     }
     sendMapOdom();
   }
@@ -750,9 +747,16 @@ void ScanMatcherNodelet::sendMapOdom() {
   if (!map_odom_ || !tf_broadcaster_) return;
   // Valid from now until the next update: post-dated so that lookups at the current time (a
   // costmap, a planner) do not need to extrapolate.
-  tf_broadcaster_->sendTransform(stampedTransform(
-      *map_odom_, params_.map_frame, params_.odom_frame,
-      ros::Time::now() + ros::Duration(params_.transform_tolerance)));
+  sendMapOdomAt(ros::Time::now() + ros::Duration(params_.transform_tolerance));
+}
+
+void ScanMatcherNodelet::sendMapOdomAt(const ros::Time& stamp) {
+  // Never the same stamp twice: under simulated time a paused or slow clock would repeat it,
+  // and tf listeners warn TF_REPEATED_DATA for each repetition.
+  if (last_map_odom_stamp_ && stamp == *last_map_odom_stamp_) return;
+  last_map_odom_stamp_ = stamp;
+  tf_broadcaster_->sendTransform(
+      stampedTransform(*map_odom_, params_.map_frame, params_.odom_frame, stamp));
 }
 
 void ScanMatcherNodelet::diagnose(diagnostic_updater::DiagnosticStatusWrapper& stat) {

@@ -103,8 +103,10 @@ void SweepAssemblerNodelet::onInit() {
   updater_ = std::make_unique<diagnostic_updater::Updater>(nh, pnh, getName());
   updater_->setHardwareID("none");
   updater_->add("sweep assembly", this, &SweepAssemblerNodelet::diagnose);
+  // force_update: update() skips a tick that comes a little early, and stays silent after a
+  // bag loop until the (simulated) clock is back where it was.
   diagnostics_timer_ = nh.createTimer(ros::Duration(1.0), [this](const ros::TimerEvent&) {
-    updater_->update();
+    updater_->force_update();
   });
   try {
     params_ = loadAssemblerParams(pnh);

@@ -19,6 +19,7 @@
 #include <sensor_msgs/point_cloud2_iterator.h>
 #include <std_srvs/Trigger.h>
 #include <tf2_eigen/tf2_eigen.h>
+#include <rosgraph_msgs/Clock.h>
 #include <tf2_msgs/TFMessage.h>
 #include <tf2_ros/buffer.h>
 #include <tf2_ros/static_transform_broadcaster.h>
@@ -660,6 +661,55 @@ TEST_F(ScanMatcherSlow, ServicesDiagnosticsAndTfAnswerWhileARegistrationRuns) {
               "diagnostics %.2f s, map -> odom %.3f s\n",
               ended - started, answered - called, largestGap(diagnostics_at),
               largestGap(map_odom_at));
+}
+
+/// The matcher on simulated time (test/ros/sim_time.test): the test publishes /clock.
+class ScanMatcherSimTime : public ScanMatcherRos {};
+
+// Under simulated time map -> odom is sent after every scan and by a timer, each stamped
+// now + transform_tolerance: within one step of the clock both would carry the same stamp,
+// which tf listeners warn about (TF_REPEATED_DATA). A stamp is never sent twice.
+TEST_F(ScanMatcherSimTime, MapOdomNeverRepeatsAStamp) {
+  ros::Publisher clock_pub = nh.advertise<rosgraph_msgs::Clock>("/clock", 1, true);
+  std::vector<ros::Time> stamps;  // of every map -> odom sent
+  ros::Subscriber tf_sub = nh.subscribe<tf2_msgs::TFMessage>(
+      "/tf", 100, [&](const tf2_msgs::TFMessage::ConstPtr& m) {
+        for (const auto& t : m->transforms) {
+          if (t.header.frame_id == "map" && t.child_frame_id == "odom") {
+            stamps.push_back(t.header.stamp);
+          }
+        }
+      });
+  ros::Time now(1000.0);
+  auto setClock = [&](const ros::Time& t) {
+    rosgraph_msgs::Clock c;
+    c.clock = now = t;
+    clock_pub.publish(c);
+    spinFor(0.3);
+  };
+  setClock(now);
+  const sim::Scene scene = sim::Scene::generate(sim::SceneType::Urban, 3);
+  std::mt19937_64 rng(41);
+  Eigen::Isometry3d body = Eigen::Isometry3d::Identity();
+  body.translation() = Eigen::Vector3d(0, 0, scene.groundHeight(0, 0) + 0.5);
+  const PointArray pts = sweepInBase(scene, body, rng);
+  auto sendAtNow = [&] {
+    tf_pub.sendTransform(stampedTransform(body, "odom", "base_link", now));
+    spinFor(0.1);
+    return send(makeCloud(pts, "base_link", now));
+  };
+  EXPECT_EQ(sendAtNow().reason, Status::FIRST_SCAN);
+  for (int k = 0; k < 8; ++k) {
+    setClock(now + ros::Duration(0.25));  // the timer sends at this clock step...
+    EXPECT_EQ(sendAtNow().reason, Status::ACCEPTED);  // ... and so does the scan
+    spinFor(0.2);
+  }
+  ASSERT_GE(stamps.size(), 9u) << "map -> odom was not sent after each scan";
+  std::vector<ros::Time> sorted = stamps;
+  std::sort(sorted.begin(), sorted.end());
+  const auto repeated = std::adjacent_find(sorted.begin(), sorted.end());
+  EXPECT_EQ(repeated, sorted.end()) << "map -> odom sent twice at " << repeated->toSec() << " s ("
+                                    << stamps.size() << " sent)";
 }
 
 }  // namespace

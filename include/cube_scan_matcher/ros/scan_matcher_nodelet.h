@@ -157,8 +157,10 @@ class ScanMatcherNodelet : public nodelet::Nodelet {
   // map -> odom, sent at once after each scan and re-sent on tf_timer_, stamped
   // now + transform_tolerance (as amcl does) so that lookups at the current time succeed.
   void sendMapOdom();
-  std::mutex tf_mutex_;  // guards map_odom_ (the timer must not wait for a registration)
+  void sendMapOdomAt(const ros::Time& stamp);  ///< under tf_mutex_
+  std::mutex tf_mutex_;  // guards the two below (the timer must not wait for a registration)
   std::optional<Eigen::Isometry3d> map_odom_;
+  std::optional<ros::Time> last_map_odom_stamp_;
   ros::Timer tf_timer_;
 
   std::unique_ptr<ChainCovariance> chain_;  // the published pose's covariance along the chain
