@@ -316,9 +316,13 @@ void SweepAssemblerNodelet::applyCut(const CutResult& r, Line&& line,
                                      const sensor_msgs::LaserScan& scan) {
   if (r.line_kept) pending_.push_back(std::move(line));
   if (r.reason == CutReason::Stall) {
-    NODELET_WARN("the tilt has not moved by more than turn_hysteresis = %.4f rad for "
-                 "stall_timeout = %.2f s (line at %.3f s): sweep closed; lines are discarded "
-                 "until it moves again",
+    // Named with the axis and frame it is measured about: a laser that nods about another
+    // axis (tilt_axis x while it pitches about y) looks stalled too.
+    NODELET_WARN("the tilt about %c (tilt_axis) of the laser in '%s' (tilt_reference_frame) has "
+                 "not moved by more than turn_hysteresis = %.4f rad for stall_timeout = %.2f s "
+                 "(line at %.3f s): sweep closed; lines are discarded until it moves again. If "
+                 "the laser is moving, check tilt_axis and tilt_reference_frame",
+                 char('x' + params_.tilt_axis), params_.tilt_reference_frame.c_str(),
                  params_.cutter.turn_hysteresis, params_.cutter.stall_timeout,
                  scan.header.stamp.toSec());
   }
