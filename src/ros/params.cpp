@@ -32,7 +32,7 @@ void configToSettings(const ScanMatcherConfig& c, OnlineMatcherSettings& m) {
   r.grid.cube_edge = c.cube_edge;
   r.gnmm.vertices = c.vertices;
   r.gnmm.max_iterations = c.iterations;
-  const double a = deg2rad(c.bounds_rotation);
+  const double a = deg2rad(c.bounds_rotation_deg);
   r.gnmm.bounds << c.bounds_translation, c.bounds_translation, c.bounds_translation, a, a, a;
   r.gnmm.seed = std::uint64_t(c.seed);
   r.search.starts = c.starts;
@@ -54,14 +54,14 @@ void configToSettings(const ScanMatcherConfig& c, OnlineMatcherSettings& m) {
   r.polish.kernel = c.polish_kernel;
   m.gate.min_overlap = c.min_overlap;
   m.gate.max_correction_m = c.max_correction_translation;
-  m.gate.max_correction_rad = deg2rad(c.max_correction_rotation);
+  m.gate.max_correction_rad = deg2rad(c.max_correction_rotation_deg);
   m.gate.require_polish = c.require_polish;
   m.gate.reject_degenerate = c.reject_degenerate;
   m.gate.reject_ambiguous = c.reject_ambiguous;
   m.gate.max_sigma_m = c.max_sigma_translation;
   m.max_consecutive_rejections = c.max_consecutive_rejections;
   m.keyframes.distance = c.keyframe_distance;
-  m.keyframes.angle = deg2rad(c.keyframe_angle);
+  m.keyframes.angle = deg2rad(c.keyframe_angle_deg);
   m.keyframes.interval = c.keyframe_interval;
   m.keyframes.submap_size = c.submap_keyframes;
   m.constant_velocity = c.constant_velocity;
@@ -118,7 +118,7 @@ ScanMatcherConfig toConfig(const NodeParams& p) {
   c.vertices = r.gnmm.vertices;
   c.iterations = r.gnmm.max_iterations;
   c.bounds_translation = r.gnmm.bounds[0];
-  c.bounds_rotation = rad2deg(r.gnmm.bounds[3]);
+  c.bounds_rotation_deg = rad2deg(r.gnmm.bounds[3]);
   c.seed = int(r.gnmm.seed);
   c.starts = r.search.starts;
   c.retries = r.search.retries;
@@ -139,14 +139,14 @@ ScanMatcherConfig toConfig(const NodeParams& p) {
   c.polish_kernel = r.polish.kernel;
   c.min_overlap = p.matcher.gate.min_overlap;
   c.max_correction_translation = p.matcher.gate.max_correction_m;
-  c.max_correction_rotation = rad2deg(p.matcher.gate.max_correction_rad);
+  c.max_correction_rotation_deg = rad2deg(p.matcher.gate.max_correction_rad);
   c.require_polish = p.matcher.gate.require_polish;
   c.reject_degenerate = p.matcher.gate.reject_degenerate;
   c.reject_ambiguous = p.matcher.gate.reject_ambiguous;
   c.max_sigma_translation = p.matcher.gate.max_sigma_m;
   c.max_consecutive_rejections = p.matcher.max_consecutive_rejections;
   c.keyframe_distance = p.matcher.keyframes.distance;
-  c.keyframe_angle = rad2deg(p.matcher.keyframes.angle);
+  c.keyframe_angle_deg = rad2deg(p.matcher.keyframes.angle);
   c.keyframe_interval = p.matcher.keyframes.interval;
   c.submap_keyframes = p.matcher.keyframes.submap_size;
   c.constant_velocity = p.matcher.constant_velocity;
@@ -155,19 +155,62 @@ ScanMatcherConfig toConfig(const NodeParams& p) {
   return c;
 }
 
+const std::vector<std::string>& knownParamNames() {
+  static const std::vector<std::string> names = [] {
+    std::vector<std::string> n = {
+        "base_frame", "odom_frame", "map_frame", "tf_timeout", "time_jump_reset",
+        "missing_tf_policy", "role", "odometry_sigma_translation", "odometry_sigma_rotation_deg",
+        "reset_continuous", "transform_tolerance", "tf_rate", "queue_size", "path_max_length",
+        "range_min", "range_max", "time_field", "max_grid_megabytes", "byte_grid_megabytes",
+        "sigma_translation", "sigma_rotation_deg", "registration_sigma_scale", "drift_percent",
+        "rejected_sigma_translation", "rejected_sigma_rotation_deg", "min_rate", "max_rate",
+        "max_latency"};
+    for (const auto& d : ScanMatcherConfig::__getParamDescriptions__()) n.push_back(d->name);
+    return n;
+  }();
+  return names;
+}
+
 NodeParams loadParams(const ros::NodeHandle& pnh) {
   NodeParams p;
+  // Renamed parameters are refused with their new name: the old value must not be lost.
+  static const std::pair<const char*, const char*> kRenamed[] = {
+      {"bounds_rotation", "bounds_rotation_deg"},
+      {"max_correction_rotation", "max_correction_rotation_deg"},
+      {"keyframe_angle", "keyframe_angle_deg"},
+      {"sigma_rotation", "sigma_rotation_deg"},
+      {"odometry_sigma_rotation", "odometry_sigma_rotation_deg"},
+      {"rejected_sigma_rotation", "rejected_sigma_rotation_deg"},
+      {"min_range", "range_min"},
+      {"max_range", "range_max"}};
+  for (const auto& [old_name, new_name] : kRenamed) {
+    if (pnh.hasParam(old_name)) {
+      throw ParamError(std::string("parameter ~") + old_name + " is now called ~" + new_name +
+                       " (angles carry _deg in their names, ranges are named as LaserScan's)");
+    }
+  }
   p.base_frame = getString(pnh, "base_frame", p.base_frame);
-  p.odom_frame = getString(pnh, "odom_frame", p.odom_frame);
+  // odom_frame "" = a robot without odometry: no lookup, the motion model predicts each scan.
+  if (pnh.hasParam("odom_frame") && !pnh.getParam("odom_frame", p.odom_frame)) {
+    throw ParamError("parameter ~odom_frame must be a string (empty = no odometry)");
+  }
   p.map_frame = getString(pnh, "map_frame", p.map_frame);
   if (p.map_frame == p.odom_frame || p.map_frame == p.base_frame) {
     throw ParamError("parameter ~map_frame must differ from ~odom_frame and ~base_frame");
   }
+  if (p.odom_frame == p.base_frame) {
+    throw ParamError("parameter ~odom_frame must differ from ~base_frame (empty = no odometry)");
+  }
   p.tf_timeout = readParam(pnh, "tf_timeout", p.tf_timeout, 0.0, 10.0, "s");
   p.time_jump_reset = readParam(pnh, "time_jump_reset", p.time_jump_reset, 0.0, 3600.0, "s");
-  const std::string policy = getString(pnh, "missing_tf_policy", "identity");
-  if (policy != "identity" && policy != "skip") {
-    throw ParamError("parameter ~missing_tf_policy = '" + policy + "' must be identity or skip");
+  const std::string policy = getString(pnh, "missing_tf_policy", "predict");
+  if (policy == "identity") {
+    throw ParamError(
+        "parameter ~missing_tf_policy = 'identity' is now called 'predict' (a scan without "
+        "odometry is registered from the motion model's prediction, not from an identity)");
+  }
+  if (policy != "predict" && policy != "skip") {
+    throw ParamError("parameter ~missing_tf_policy = '" + policy + "' must be predict or skip");
   }
   p.skip_without_tf = policy == "skip";
   if (pnh.hasParam("publish_tf")) {
@@ -180,10 +223,20 @@ NodeParams loadParams(const ros::NodeHandle& pnh) {
   else if (role == "map_odom") p.role = NodeParams::Role::MapOdom;
   else if (role == "anchored") p.role = NodeParams::Role::Anchored;
   else throw ParamError("parameter ~role = '" + role + "' must be messages, map_odom or anchored");
+  if (p.odom_frame.empty() && p.role != NodeParams::Role::Messages) {
+    throw ParamError("parameter ~role = '" + role +
+                     "' needs odometry (it sends map -> odom): with ~odom_frame empty (no "
+                     "odometry) only role messages is possible");
+  }
+  if (p.odom_frame.empty() && p.skip_without_tf) {
+    throw ParamError(
+        "parameter ~missing_tf_policy = 'skip' with ~odom_frame empty (no odometry) would drop "
+        "every scan: use predict");
+  }
   p.reset_continuous = getBool(pnh, "reset_continuous", p.reset_continuous);
   p.anchor.odometry_sigma_m = readParam(pnh, "odometry_sigma_translation",
                                         p.anchor.odometry_sigma_m, 1e-3, 1e3, "m");
-  p.anchor.odometry_sigma_rad = deg2rad(readParam(pnh, "odometry_sigma_rotation",
+  p.anchor.odometry_sigma_rad = deg2rad(readParam(pnh, "odometry_sigma_rotation_deg",
                                                   rad2deg(p.anchor.odometry_sigma_rad), 1e-3,
                                                   180.0, "deg"));
   p.transform_tolerance =
@@ -191,22 +244,22 @@ NodeParams loadParams(const ros::NodeHandle& pnh) {
   p.tf_rate = readParam(pnh, "tf_rate", p.tf_rate, 0.1, 1000.0, "Hz");
   p.queue_size = readParam(pnh, "queue_size", p.queue_size, 1, 100);
   p.path_max_length = readParam(pnh, "path_max_length", p.path_max_length, 1, 1000000);
-  p.filter.min_range = readParam(pnh, "min_range", p.filter.min_range, 0.0, 1e4, "m");
-  const double max_range = readParam(pnh, "max_range", 0.0, 0.0, 1e6, "m (0 = no limit)");
-  p.filter.max_range = max_range > 0.0 ? max_range : 1e9;
+  p.filter.min_range = readParam(pnh, "range_min", p.filter.min_range, 0.0, 1e4, "m");
+  const double range_max = readParam(pnh, "range_max", 0.0, 0.0, 1e6, "m (0 = no limit)");
+  p.filter.max_range = range_max > 0.0 ? range_max : 1e9;
   if (p.filter.max_range <= p.filter.min_range) {
-    throw ParamError("parameter ~max_range must exceed ~min_range (or be 0 = no limit)");
+    throw ParamError("parameter ~range_max must exceed ~range_min (or be 0 = no limit)");
   }
   if (pnh.hasParam("time_field") && !pnh.getParam("time_field", p.time_field)) {
     throw ParamError("parameter ~time_field must be a string (empty = no point times)");
   }
   p.chain.sigma_m = readParam(pnh, "sigma_translation", p.chain.sigma_m, 1e-6, 100.0, "m");
   p.chain.sigma_rad =
-      deg2rad(readParam(pnh, "sigma_rotation", rad2deg(p.chain.sigma_rad), 1e-6, 180.0, "deg"));
+      deg2rad(readParam(pnh, "sigma_rotation_deg", rad2deg(p.chain.sigma_rad), 1e-6, 180.0, "deg"));
   if (pnh.hasParam("rejected_sigma_scale")) {
     throw ParamError(
         "parameter ~rejected_sigma_scale is not read: set ~rejected_sigma_translation [m] and "
-        "~rejected_sigma_rotation [deg], the odometry's error over one increment");
+        "~rejected_sigma_rotation_deg [deg], the odometry's error over one increment");
   }
   p.chain.registration_scale = readParam(pnh, "registration_sigma_scale",
                                          p.chain.registration_scale, 1e-3, 1.0);
@@ -215,7 +268,7 @@ NodeParams loadParams(const ros::NodeHandle& pnh) {
   p.chain.rejected_sigma_m = readParam(pnh, "rejected_sigma_translation", p.chain.rejected_sigma_m,
                                        1e-6, 100.0, "m");
   p.chain.rejected_sigma_rad =
-      deg2rad(readParam(pnh, "rejected_sigma_rotation", rad2deg(p.chain.rejected_sigma_rad), 1e-6,
+      deg2rad(readParam(pnh, "rejected_sigma_rotation_deg", rad2deg(p.chain.rejected_sigma_rad), 1e-6,
                         180.0, "deg"));
   p.min_rate = readParam(pnh, "min_rate", p.min_rate, 0.0, 1000.0, "Hz");
   p.max_rate = readParam(pnh, "max_rate", p.max_rate, 0.0, 1e6, "Hz");

@@ -89,6 +89,10 @@ void ScanMatcherNodelet::onInit() {
                   e.what());
     return;
   }
+  for (const std::string& w : unknownParamWarnings(privateParamNames(pnh), knownParamNames())) {
+    NODELET_WARN("%s", w.c_str());
+    param_warnings_ += (param_warnings_.empty() ? "" : "; ") + w;
+  }
   matcher_ = std::make_unique<OnlineMatcher>(params_.matcher);
   chain_ = std::make_unique<ChainCovariance>(params_.chain);
   anchor_ = std::make_unique<OdometryAnchor>(params_.anchor);
@@ -138,7 +142,8 @@ void ScanMatcherNodelet::onInit() {
   NODELET_INFO(
       "ScanMatcherNodelet: registering %s in %s (odometry %s, poses in %s), E = %.2f m, "
       "SIMD path %s",
-      cloud_sub_.getTopic().c_str(), params_.base_frame.c_str(), params_.odom_frame.c_str(),
+      cloud_sub_.getTopic().c_str(), params_.base_frame.c_str(),
+      params_.odom_frame.empty() ? "none: predicted" : params_.odom_frame.c_str(),
       params_.map_frame.c_str(), cube_edge, simdReport().c_str());
 }
 
@@ -292,7 +297,7 @@ std::string ScanMatcherNodelet::parseStart(const geometry_msgs::PoseWithCovarian
   // The pose holds at the request's stamp: the next scan's start is moved on by the odometry
   // from that stamp to its own (a zero stamp: the pose holds at the next scan).
   start.odom.reset();
-  if (!req.header.stamp.isZero()) {
+  if (!req.header.stamp.isZero() && !params_.odom_frame.empty()) {
     std::string error;
     start.odom = lookup(params_.odom_frame, params_.base_frame, req.header.stamp, error);
     if (!start.odom && !stamp_is_approximate) {
@@ -505,8 +510,9 @@ bool ScanMatcherNodelet::trackStamps(Scan& scan) {
 
 void ScanMatcherNodelet::countArrival(const sensor_msgs::PointCloud2& msg) {
   // Scans the subscriber queue dropped never reach this callback: they are counted from the
-  // header.seq gap, as drops and as arrivals of the input rate. (A publisher in the same
-  // manager hands its message over without a seq: such drops are not seen here.)
+  // header.seq gap, as drops and as arrivals of the input rate. roscpp numbers seq when it
+  // serialises (the sweep assembler publishes by value, so always); a publisher in the same
+  // manager that hands over a pointer keeps its own seq, and its queue drops are not seen.
   const std::uint32_t seq = msg.header.seq;
   std::uint32_t gap = 0;
   if (last_seq_ && seq > *last_seq_ + 1) gap = std::min<std::uint32_t>(seq - *last_seq_ - 1, 10000);
@@ -523,17 +529,20 @@ bool ScanMatcherNodelet::lookupFrames(Scan& scan) {
   std::optional<Eigen::Isometry3d> T_base_cloud =
       frame == params_.base_frame ? std::optional<Eigen::Isometry3d>(Eigen::Isometry3d::Identity())
                                   : lookup(params_.base_frame, frame, stamp, tf_error);
-  scan.odom = lookup(params_.odom_frame, params_.base_frame, stamp, tf_error);
-  if (scan.status.time_reset && (!T_base_cloud || !scan.odom)) {
+  const bool odometry = !params_.odom_frame.empty();  // "" = none: the motion model predicts
+  if (odometry) scan.odom = lookup(params_.odom_frame, params_.base_frame, stamp, tf_error);
+  if (scan.status.time_reset && (!T_base_cloud || (odometry && !scan.odom))) {
     // After a jump back by more than the tf cache, the buffer refuses the new (older) tf as
     // TF_OLD_DATA: clear it, so that tf from here on is taken, and look once more.
     NODELET_WARN("tf buffer cleared after the time jump: %s", tf_error.c_str());
     tf_buffer_->clear();
     tf_error.clear();
     if (!T_base_cloud) T_base_cloud = lookup(params_.base_frame, frame, stamp, tf_error);
-    if (!scan.odom) scan.odom = lookup(params_.odom_frame, params_.base_frame, stamp, tf_error);
+    if (odometry && !scan.odom) {
+      scan.odom = lookup(params_.odom_frame, params_.base_frame, stamp, tf_error);
+    }
   }
-  scan.status.tf_failed = !T_base_cloud || !scan.odom;
+  scan.status.tf_failed = !T_base_cloud || (odometry && !scan.odom);
   if (scan.status.tf_failed) {
     ++tf_failures_;
     NODELET_WARN_THROTTLE(5.0, "tf missing for scan at %.3f s within %.2f s: %s", stamp.toSec(),
@@ -590,7 +599,7 @@ bool ScanMatcherNodelet::convertPoints(Scan& scan) {
   if (scan.points.empty()) {
     std::ostringstream os;
     os << "cloud has no usable point: " << fs.input << " points, " << fs.non_finite
-       << " NaN/inf, " << fs.out_of_range << " outside [min_range, max_range]";
+       << " NaN/inf, " << fs.out_of_range << " outside [range_min, range_max]";
     rejectInput(scan, os.str());
     return false;
   }
@@ -790,6 +799,10 @@ void ScanMatcherNodelet::diagnose(diagnostic_updater::DiagnosticStatusWrapper& s
     stat.summary(DiagnosticStatus::WARN, "some scans rejected, dropped or without tf");
   } else {
     stat.summary(DiagnosticStatus::OK, processed ? "registering" : "waiting for scans");
+  }
+  if (!param_warnings_.empty()) {
+    stat.add("unknown parameters", param_warnings_);
+    stat.mergeSummary(DiagnosticStatus::WARN, "unknown parameters (misspelt?)");
   }
 }
 

@@ -37,6 +37,14 @@ double angleAbout(const Eigen::Matrix3d& R, int axis) {
 
 }  // namespace
 
+const std::vector<std::string>& knownAssemblerParamNames() {
+  static const std::vector<std::string> names = {
+      "fixed_frame",  "tilt_reference_frame", "tilt_axis", "turn_hysteresis", "sweep_duration",
+      "stall_timeout", "max_line_gap",        "min_lines", "max_lines",       "tf_timeout",
+      "range_min",     "range_max",           "queue_size"};
+  return names;
+}
+
 AssemblerParams loadAssemblerParams(const ros::NodeHandle& pnh) {
   AssemblerParams p;
   p.fixed_frame = readString(pnh, "fixed_frame", p.fixed_frame);
@@ -116,6 +124,11 @@ void SweepAssemblerNodelet::onInit() {
     NODELET_ERROR("%s. SweepAssemblerNodelet is NOT running: fix the parameter and restart it.",
                   e.what());
     return;
+  }
+  for (const std::string& w :
+       unknownParamWarnings(privateParamNames(pnh), knownAssemblerParamNames())) {
+    NODELET_WARN("%s", w.c_str());
+    param_warnings_ += (param_warnings_.empty() ? "" : "; ") + w;
   }
   cutter_ = std::make_unique<SweepCutter>(params_.cutter);
   // tf is kept 30 s: far more than any line waits (tf_timeout <= 10 s).
@@ -389,6 +402,9 @@ void SweepAssemblerNodelet::publishSweep(std::size_t lines, CutReason reason) {
     std::stable_sort(points.begin(), points.end(), earlier);
   }
 
+  // Published by value: roscpp serialises it even for a subscriber in the same manager (one
+  // copy of the sweep), and numbers header.seq, from which the matcher counts the sweeps its
+  // queue dropped.
   sensor_msgs::PointCloud2 cloud;
   cloud.header.frame_id = params_.fixed_frame;
   cloud.header.stamp = reference;
@@ -456,6 +472,10 @@ void SweepAssemblerNodelet::diagnose(diagnostic_updater::DiagnosticStatusWrapper
     stat.summary(DiagnosticStatus::WARN, "some lines dropped or sweeps discarded");
   } else {
     stat.summary(DiagnosticStatus::OK, sweeps_published_ ? "assembling" : "waiting for a sweep");
+  }
+  if (!param_warnings_.empty()) {
+    stat.add("unknown parameters", param_warnings_);
+    stat.mergeSummary(DiagnosticStatus::WARN, "unknown parameters (misspelt?)");
   }
 }
 

@@ -251,10 +251,10 @@ TEST_F(FaultsSkipPolicy, OdometryTfMissingForTwoSecondsThenResumes) {
   }
 }
 
-// missing_tf_policy identity (the default): scans in the gap are registered from an identity
+// missing_tf_policy predict (the default): scans in the gap are registered from the prediction
 // guess and flagged. The first scan after the gap is guessed from the odometry of the last
 // scan that had it (carried over the accepted increments since), and registration goes on.
-// Whether the chain is right across the gap depends on the identity registrations (1-2 m of
+// Whether the chain is right across the gap depends on the predicted registrations (1-2 m of
 // travel per scan here); the increments after it must be right.
 TEST_F(Faults, OdometryTfMissingForTwoSecondsThenResumes) {
   for (int k = 0; k < 10; ++k) {

@@ -12,6 +12,7 @@
 #include <boost/any.hpp>
 
 #include "cube_scan_matcher/ros/params.h"
+#include "cube_scan_matcher/ros/sweep_assembler_nodelet.h"
 #include "expect_params.h"
 
 using namespace cube_scan_matcher;
@@ -143,4 +144,46 @@ TEST(Params, YamlAndReadmeListTheCfgParametersWithItsDefaultsAndRanges) {
           << "docs/parameters.md row not in the cfg: " << l;
     }
   }
+}
+
+namespace {
+
+/// The top-level keys of a YAML file ("name: value  # ..." at the start of a line).
+std::set<std::string> yamlKeys(const std::string& path) {
+  std::set<std::string> keys;
+  for (const std::string& l : lines(readFile(path))) {
+    const std::size_t colon = l.find(':');
+    if (l.empty() || l[0] == '#' || l[0] == ' ' || colon == std::string::npos) continue;
+    keys.insert(l.substr(0, colon));
+  }
+  return keys;
+}
+
+}  // namespace
+
+// The names the nodelets warn about are those they do not read: each list is exactly its
+// shipped YAML's keys (the YAML lists every parameter), so a new parameter cannot be read
+// without being known, nor known without being documented.
+TEST(Params, KnownNamesAreTheYamlKeys) {
+  const auto& matcher = knownParamNames();
+  EXPECT_EQ(std::set<std::string>(matcher.begin(), matcher.end()),
+            yamlKeys(CSM_SOURCE_DIR "/config/scan_matcher.yaml"));
+  EXPECT_EQ(matcher.size(), std::set<std::string>(matcher.begin(), matcher.end()).size());
+  const auto& assembler = knownAssemblerParamNames();
+  EXPECT_EQ(std::set<std::string>(assembler.begin(), assembler.end()),
+            yamlKeys(CSM_SOURCE_DIR "/config/sweep_assembler.yaml"));
+}
+
+TEST(Params, UnknownNamesAreWarnedWithTheClosestKnownName) {
+  const auto warnings = unknownParamWarnings(
+      {"keyframe_distanse", "base_frame", "tilt_axis", "completely_unrelated_name"},
+      knownParamNames());
+  ASSERT_EQ(warnings.size(), 3u);
+  EXPECT_NE(warnings[0].find("~keyframe_distanse is not a parameter"), std::string::npos);
+  EXPECT_NE(warnings[0].find("did you mean ~keyframe_distance?"), std::string::npos);
+  EXPECT_NE(warnings[1].find("~tilt_axis"), std::string::npos);  // the assembler's, not ours
+  EXPECT_NE(warnings[2].find("docs/parameters.md"), std::string::npos) << warnings[2];
+  EXPECT_TRUE(unknownParamWarnings({"cube_edge", "range_min"}, knownParamNames()).empty());
+  EXPECT_EQ(editDistance("range_min", "range_max"), 2u);
+  EXPECT_EQ(editDistance("", "abc"), 3u);
 }

@@ -569,6 +569,71 @@ TEST(ScanMatcherBadParam, RefusesToStartAndNamesTheParameter) {
   EXPECT_FALSE(ros::service::exists(kNs + "reset", false));
 }
 
+/// The matcher configured without odometry (test/ros/no_odometry.test: odom_frame "").
+class ScanMatcherNoOdometry : public ScanMatcherRos {};
+
+// No odometry on tf and none configured: no scan waits the 5 s tf_timeout or counts a tf
+// failure, and each is registered from the prediction (the robot stands still between scans
+// 0.2 m apart, well within the search bounds).
+TEST_F(ScanMatcherNoOdometry, RegistersFromThePredictionWithoutWaitingForTf) {
+  const sim::Scene scene = sim::Scene::generate(sim::SceneType::Urban, 3);
+  Eigen::Isometry3d body = Eigen::Isometry3d::Identity();
+  body.linear() = Eigen::AngleAxisd(0.3, Eigen::Vector3d::UnitZ()).toRotationMatrix();
+  std::mt19937_64 rng(5);
+  ros::Time stamp = ros::Time::now();
+  for (int k = 0; k < 4; ++k) {
+    body.translation() += 0.2 * body.linear().col(0);
+    body.translation().z() = scene.groundHeight(body.translation().x(), body.translation().y()) + 0.5;
+    stamp += ros::Duration(0.5);
+    const Status s = send(makeCloud(sweepInBase(scene, body, rng), "base_link", stamp));
+    EXPECT_FALSE(s.tf_failed) << "scan " << k;
+    EXPECT_FALSE(s.odometry_guess) << "scan " << k;
+    EXPECT_LT(s.latency, 4.0) << "scan " << k << " waited for an odometry tf";
+    EXPECT_NE(s.reason, Status::SKIPPED_NO_TF) << "scan " << k;
+    EXPECT_NE(s.reason, Status::NON_FINITE) << "scan " << k;
+  }
+  ASSERT_EQ(out.status.size(), 4u);
+  EXPECT_EQ(out.status[0].reason, Status::FIRST_SCAN);
+  EXPECT_GE(std::count_if(out.status.begin() + 1, out.status.end(),
+                          [](const Status& s) { return s.accepted; }), 2)
+      << "scans 1-3 registered from the prediction";
+  ASSERT_FALSE(out.pose.empty());
+  EXPECT_EQ(out.pose.back().header.frame_id, "map");
+}
+
+// test/ros/param_names.test: a misspelt name is a WARN naming it and the closest known name
+// (the nodelet runs); a renamed one refuses the start with the new name.
+TEST(ScanMatcherParamNames, MisspeltIsWarnedAndRenamedIsRefused) {
+  ros::NodeHandle nh;
+  std::vector<diagnostic_msgs::DiagnosticStatus> diagnostics;
+  ros::Subscriber sub = nh.subscribe<diagnostic_msgs::DiagnosticArray>(
+      "/diagnostics", 10, [&](const diagnostic_msgs::DiagnosticArray::ConstPtr& m) {
+        for (const auto& s : m->status) diagnostics.push_back(s);
+      });
+  auto seen = [&](const std::string& node, std::uint8_t level, const std::string& text) {
+    for (const auto& d : diagnostics) {
+      if (d.name.find(node) == std::string::npos || d.level != level) continue;
+      if (d.message.find(text) != std::string::npos) return true;
+      for (const auto& kv : d.values) {
+        if (kv.value.find(text) != std::string::npos) return true;
+      }
+    }
+    return false;
+  };
+  using diagnostic_msgs::DiagnosticStatus;
+  EXPECT_TRUE(waitFor([&] {
+    return seen("misspelt", DiagnosticStatus::WARN, "did you mean ~keyframe_distance?");
+  }, 30.0)) << "no WARN naming ~keyframe_distanse's closest name";
+  EXPECT_TRUE(ros::service::exists("/misspelt/reset", false)) << "the misspelt one must run";
+  EXPECT_TRUE(waitFor([&] {
+    return seen("renamed", DiagnosticStatus::ERROR, "~keyframe_angle is now called ~keyframe_angle_deg");
+  }, 30.0)) << "no ERROR naming the new name of ~keyframe_angle";
+  EXPECT_FALSE(ros::service::exists("/renamed/reset", false));
+  EXPECT_TRUE(waitFor([&] {
+    return seen("assembler", DiagnosticStatus::WARN, "did you mean ~tilt_axis?");
+  }, 30.0)) << "no WARN from the assembler naming ~tilt_axes's closest name";
+}
+
 /// The matcher with search settings that make one registration last seconds
 /// (test/ros/slow_registration.test).
 class ScanMatcherSlow : public ScanMatcherRos {};

@@ -4,6 +4,7 @@
 #pragma once
 
 #include <string>
+#include <vector>
 
 #include <ros/node_handle.h>
 
@@ -19,14 +20,14 @@ namespace cube_scan_matcher {
 struct NodeParams {
   // Frames.
   std::string base_frame = "base_link";  ///< robot frame the scans are registered in.
-  std::string odom_frame = "odom";       ///< frame of the DGPS/IMU odometry (initial guess).
+  std::string odom_frame = "odom";       ///< frame of the DGPS/IMU odometry; "" = none.
   std::string map_frame = "map";         ///< frame of the published poses and clouds.
   // tf.
   double tf_timeout = 0.1;        ///< [s] bounded wait for each tf lookup, in [0, 10].
   /// [s] a scan stamped earlier than the last one by less than this is out of order: dropped
   /// and counted; by more, time went back (bag loop, clock reset) and the state is reset.
   double time_jump_reset = 1.0;
-  bool skip_without_tf = false;   ///< missing_tf_policy: "skip" (true) or "identity" (false).
+  bool skip_without_tf = false;   ///< missing_tf_policy: "skip" (true) or "predict" (false).
   /// What the node is in a REP-105 tree (README "Using it on a robot"):
   ///  - Messages: pose, odometry and path only, no tf: a filter (robot_localization) fuses them;
   ///  - MapOdom: also map -> odom from the chain (map drifts from odom along the run);
@@ -43,13 +44,13 @@ struct NodeParams {
   // Input and outputs.
   int queue_size = 1;             ///< subscriber queue, in [1, 100].
   int path_max_length = 10000;    ///< poses kept in ~path, in [1, 1e6].
-  RangeFilterSettings filter;     ///< min_range, max_range [m] around the base_frame origin.
+  RangeFilterSettings filter;     ///< range_min, range_max [m] around the base_frame origin.
   /// Field of the per-point times [s, relative to the stamp] (the sweep assembler's "time");
   /// empty: none read. Clouds without it are rigid sweeps.
   std::string time_field = "time";
   /// Covariance of the published pose along the chain (ROS parameters sigma_translation [m],
-  /// sigma_rotation [deg], registration_sigma_scale, drift_percent [%],
-  /// rejected_sigma_translation [m], rejected_sigma_rotation [deg]).
+  /// sigma_rotation_deg [deg], registration_sigma_scale, drift_percent [%],
+  /// rejected_sigma_translation [m], rejected_sigma_rotation_deg [deg]).
   ChainCovarianceSettings chain;
   // Diagnostics.
   double min_rate = 0.05;         ///< [Hz] input rate below this is a WARN.
@@ -62,6 +63,10 @@ struct NodeParams {
 /// Reads every parameter from the private node handle, with defaults for those not set.
 /// Throws ParamError naming the first bad one.
 NodeParams loadParams(const ros::NodeHandle& pnh);
+
+/// Every parameter name loadParams reads (the fixed ones and the cfg's live ones): a name set
+/// under the nodelet's namespace and not in this list is warned about (unknownParamWarnings).
+const std::vector<std::string>& knownParamNames();
 
 /// Applies the live parameters of a dynamic_reconfigure request to `params.matcher`. Throws
 /// ParamError if the combination is invalid (params unchanged then).

@@ -191,6 +191,7 @@ class ScanMatcherNodelet : public nodelet::Nodelet {
   std::deque<double> latencies_;  // last latencies [s], for diagnostics (stats_mutex_)
   std::atomic<bool> initialised_{false};
   std::string init_error_;
+  std::string param_warnings_;  ///< unknown names under ~ (misspelt?): a WARN in diagnostics.
 };
 
 }  // namespace cube_scan_matcher

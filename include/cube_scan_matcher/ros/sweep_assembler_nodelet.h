@@ -49,6 +49,9 @@ struct AssemblerParams {
 /// (ros/params.h) naming the first bad one.
 AssemblerParams loadAssemblerParams(const ros::NodeHandle& pnh);
 
+/// Every parameter name loadAssemblerParams reads: others under ~ are warned about.
+const std::vector<std::string>& knownAssemblerParamNames();
+
 class SweepAssemblerNodelet : public nodelet::Nodelet {
  public:
   SweepAssemblerNodelet() = default;
@@ -117,6 +120,7 @@ class SweepAssemblerNodelet : public nodelet::Nodelet {
   std::uint64_t points_published_ = 0;
   bool initialised_ = false;
   std::string init_error_;
+  std::string param_warnings_;  ///< unknown names under ~ (misspelt?): a WARN in diagnostics.
 };
 
 }  // namespace cube_scan_matcher
