@@ -164,7 +164,9 @@ const std::vector<std::string>& knownParamNames() {
         "range_min", "range_max", "time_field", "max_grid_megabytes", "byte_grid_megabytes",
         "sigma_translation", "sigma_rotation_deg", "registration_sigma_scale", "drift_percent",
         "rejected_sigma_translation", "rejected_sigma_rotation_deg", "min_rate", "max_rate",
-        "max_latency"};
+        "max_latency",
+        // Read in the same namespace by the stand-alone node's nodelet::Loader (its threads).
+        "num_worker_threads"};
     for (const auto& d : ScanMatcherConfig::__getParamDescriptions__()) n.push_back(d->name);
     return n;
   }();

@@ -25,6 +25,19 @@ std::string readString(const ros::NodeHandle& pnh, const std::string& name, std:
   return value;
 }
 
+/// Keeps the longest wall time [s] of a callback in `longest` (held under the caller's lock):
+/// the assembler runs on the manager's threads, so its calls must stay short.
+struct CallTimer {
+  explicit CallTimer(double& longest) : longest_(longest) {}
+  ~CallTimer() { longest_ = std::max(longest_, (ros::WallTime::now() - begin_).toSec()); }
+  CallTimer(const CallTimer&) = delete;
+  CallTimer& operator=(const CallTimer&) = delete;
+
+ private:
+  double& longest_;
+  const ros::WallTime begin_ = ros::WallTime::now();
+};
+
 /// Rotation angle [rad] of R about axis 0, 1, 2 (x, y, z): exact when R is a rotation about
 /// that axis only.
 double angleAbout(const Eigen::Matrix3d& R, int axis) {
@@ -41,7 +54,8 @@ const std::vector<std::string>& knownAssemblerParamNames() {
   static const std::vector<std::string> names = {
       "fixed_frame",  "tilt_reference_frame", "tilt_axis", "turn_hysteresis", "sweep_duration",
       "stall_timeout", "max_line_gap",        "min_lines", "max_lines",       "tf_timeout",
-      "range_min",     "range_max",           "queue_size"};
+      "range_min",     "range_max",           "queue_size",
+      "num_worker_threads"};  // the stand-alone node's nodelet::Loader reads it here
   return names;
 }
 
@@ -96,12 +110,12 @@ SweepAssemblerNodelet::~SweepAssemblerNodelet() {
       "SweepAssemblerNodelet: %lu lines received, %lu lost before the callback, %lu dropped "
       "without tf, %lu late, %lu while the tilt was stalled, %lu bad, %lu in discarded sweeps; "
       "%lu sweeps published (%lu points), %lu discarded; %lu time resets; %zu lines left in the "
-      "current sweep, %zu waiting for tf",
+      "current sweep, %zu waiting for tf; longest callback %.1f ms",
       (unsigned long)lines_received_, (unsigned long)lines_lost_, (unsigned long)lines_dropped_tf_,
       (unsigned long)lines_late_, (unsigned long)lines_stalled_, (unsigned long)lines_bad_,
       (unsigned long)lines_in_discarded_sweeps_, (unsigned long)sweeps_published_,
       (unsigned long)points_published_, (unsigned long)sweeps_discarded_,
-      (unsigned long)time_resets_, pending_.size(), waiting_.size());
+      (unsigned long)time_resets_, pending_.size(), waiting_.size(), 1e3 * longest_call_s_);
 }
 
 void SweepAssemblerNodelet::onInit() {
@@ -137,6 +151,7 @@ void SweepAssemblerNodelet::onInit() {
   cloud_pub_ = nh.advertise<sensor_msgs::PointCloud2>("assembled_cloud", 2);
   queue_timer_ = nh.createTimer(ros::Duration(0.05), [this](const ros::TimerEvent&) {
     std::lock_guard<std::mutex> lock(mutex_);
+    const CallTimer timer(longest_call_s_);
     try {
       processQueue();
     } catch (const std::exception& e) {
@@ -164,6 +179,7 @@ void SweepAssemblerNodelet::onInit() {
 void SweepAssemblerNodelet::scanCallback(const sensor_msgs::LaserScanConstPtr& msg) {
   if (!initialised_) return;
   std::lock_guard<std::mutex> lock(mutex_);
+  const CallTimer timer(longest_call_s_);
   try {
     ++lines_received_;
     // Lines the subscriber queue dropped never reach this callback: counted from seq gaps.
@@ -466,6 +482,7 @@ void SweepAssemblerNodelet::diagnose(diagnostic_updater::DiagnosticStatusWrapper
   stat.add("lines in the current sweep", pending_.size());
   stat.add("lines waiting for tf", waiting_.size());
   stat.add("tilt stalled", was_stalled_);
+  stat.add("longest callback [s]", longest_call_s_);
   if (was_stalled_) {
     stat.summary(DiagnosticStatus::WARN, "tilt stalled: lines are discarded");
   } else if (lines_dropped_tf_ + lines_lost_ + lines_late_ + lines_bad_ + sweeps_discarded_ > 0) {

@@ -38,7 +38,7 @@ int main(int argc, char** argv) {
     const double duration = readParam(pnh, "duration", 60.0, 1.0, 86400.0, "s");
     const int distinct = readParam(pnh, "distinct", 40, 2, 10000);
     const double speed = readParam(pnh, "speed", 1.0, 0.0, 20.0, "m/s");
-    const double yaw_rate = readParam(pnh, "yaw_rate", 10.0, -90.0, 90.0, "deg/s");
+    const double yaw_rate = readParam(pnh, "yaw_rate_deg", 10.0, -90.0, 90.0, "deg/s");
     const double wait_for_subscriber = readParam(pnh, "wait_for_subscriber", 30.0, 0.0, 3600.0, "s");
     // A smoke check for scripts and CTest (not a timing check): fewer answers is an error.
     const int min_answered = readParam(pnh, "min_answered", 1, 0, 1 << 30);

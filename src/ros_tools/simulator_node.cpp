@@ -87,7 +87,7 @@ void runSweeps(ros::NodeHandle& nh, ros::NodeHandle& pnh, const Common& c) {
   sim::MotionSettings motion;
   motion.step_min = readParam(pnh, "step_min", motion.step_min, 0.0, 20.0);
   motion.step_max = readParam(pnh, "step_max", motion.step_max, motion.step_min, 20.0);
-  motion.yaw_change_max_deg = readParam(pnh, "yaw_change_max", motion.yaw_change_max_deg, 0.0, 90.0);
+  motion.yaw_change_max_deg = readParam(pnh, "yaw_change_max_deg", motion.yaw_change_max_deg, 0.0, 90.0, "deg");
   const sim::ScannerModel& model = c.model;
 
   const sim::Scene scene = sim::Scene::generate(sim::sceneTypeFromString(c.scene_name), std::uint64_t(c.seed));
@@ -230,14 +230,14 @@ void runLines(ros::NodeHandle& nh, ros::NodeHandle& pnh, const Common& c) {
   const double line_rate = readParam(pnh, "line_rate", 75.0, 1.0, 1000.0, "Hz");
   sim::DrivenPathSettings drive;
   drive.speed = readParam(pnh, "speed", 1.0, 0.0, 5.0, "m/s");
-  drive.yaw_rate_deg = readParam(pnh, "yaw_rate", 10.0, 0.0, 90.0, "deg/s");
+  drive.yaw_rate_deg = readParam(pnh, "yaw_rate_deg", 10.0, 0.0, 90.0, "deg/s");
   if (mount_frame.empty() || mount_frame == c.scanner_frame || mount_frame == c.base_frame) {
     throw ParamError("parameter ~mount_frame = '" + mount_frame +
                      "' must be a frame name distinct from ~scanner_frame and ~base_frame");
   }
   const int lines = model.psiCount();  // per sweep, psi_min .. psi_max (or back)
   if (lines < 2) {
-    throw ParamError("parameters ~psi_min, ~psi_max, ~psi_step give " + std::to_string(lines) +
+    throw ParamError("parameters ~psi_min_deg, ~psi_max_deg, ~psi_step_deg give " + std::to_string(lines) +
                      " lines per sweep; a tilting sweep needs psi_max > psi_min (at least 2 lines)");
   }
   // Sweep k has lines n = k L .. k L + L - 1 (L = lines), line n at n / line_rate after the
@@ -376,11 +376,11 @@ int main(int argc, char** argv) {
     c.seed = readParam(pnh, "seed", 1, 0, 1 << 30);
     c.sweeps = readParam(pnh, "sweeps", 0, 0, 1 << 30);  // 0 = until stopped
     sim::ScannerModel& model = c.model;
-    model.phi_step_deg = readParam(pnh, "phi_step", model.phi_step_deg, 0.05, 10.0);
-    model.psi_min_deg = readParam(pnh, "psi_min", model.psi_min_deg, -89.0, 89.0);
-    model.psi_max_deg = readParam(pnh, "psi_max", model.psi_max_deg, -89.0, 89.0);
-    model.psi_step_deg = readParam(pnh, "psi_step", model.psi_step_deg, 0.05, 10.0);
-    model.max_range = readParam(pnh, "max_range", model.max_range, 1.0, 1000.0);
+    model.phi_step_deg = readParam(pnh, "phi_step_deg", model.phi_step_deg, 0.05, 10.0, "deg");
+    model.psi_min_deg = readParam(pnh, "psi_min_deg", model.psi_min_deg, -89.0, 89.0, "deg");
+    model.psi_max_deg = readParam(pnh, "psi_max_deg", model.psi_max_deg, -89.0, 89.0, "deg");
+    model.psi_step_deg = readParam(pnh, "psi_step_deg", model.psi_step_deg, 0.05, 10.0, "deg");
+    model.max_range = readParam(pnh, "range_max", model.max_range, 1.0, 1000.0, "m");
     model.range_noise = readParam(pnh, "range_noise", model.range_noise, 0.0, 1.0);
     c.wait_for_subscriber = readParam(pnh, "wait_for_subscriber", 30.0, 0.0, 3600.0);
     c.start_delay = readParam(pnh, "start_delay", 1.0, 0.0, 3600.0);
@@ -388,9 +388,9 @@ int main(int argc, char** argv) {
     c.mount.translation() = Eigen::Vector3d(0.1, 0.0, 0.4);  // scanner 0.4 m above base_link
     // Parameters of the other input are not read: say so rather than ignore them silently.
     const std::vector<std::string> other =
-        input == "lines" ? std::vector<std::string>{"period", "organized", "step_min", "step_max", "yaw_change_max",
+        input == "lines" ? std::vector<std::string>{"period", "organized", "step_min", "step_max", "yaw_change_max_deg",
                                                             "odometry_sweeps"}
-                         : std::vector<std::string>{"line_rate", "speed", "yaw_rate", "mount_frame"};
+                         : std::vector<std::string>{"line_rate", "speed", "yaw_rate_deg", "mount_frame"};
     for (const std::string& name : other) {
       if (pnh.hasParam(name)) ROS_WARN("simulator: ~%s is not used with input %s", name.c_str(), input.c_str());
     }

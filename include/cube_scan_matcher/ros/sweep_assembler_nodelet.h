@@ -114,6 +114,7 @@ class SweepAssemblerNodelet : public nodelet::Nodelet {
   bool was_stalled_ = false;
 
   // Counters (since start), logged at shutdown and in the diagnostics.
+  double longest_call_s_ = 0.0;  // [s] wall time of the longest line callback or queue tick
   std::uint64_t lines_received_ = 0, lines_lost_ = 0, lines_dropped_tf_ = 0, lines_bad_ = 0;
   std::uint64_t lines_late_ = 0, lines_stalled_ = 0, lines_in_discarded_sweeps_ = 0;
   std::uint64_t sweeps_published_ = 0, sweeps_discarded_ = 0, time_resets_ = 0;
