@@ -1,6 +1,7 @@
 #include "cube_scan_matcher/core/online_matcher.h"
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <sstream>
 #include <stdexcept>
@@ -11,6 +12,22 @@
 #include "reuse_memory.h"
 
 namespace cube_scan_matcher {
+
+namespace {
+
+/// Wall time [s] since `start`.
+double secondsSince(std::chrono::steady_clock::time_point start) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+}
+
+/// One align() call's work, added to the step's.
+void countAlign(OnlineWork& work, const RegistrationResult& r) {
+  ++work.aligns;
+  work.searches += r.attempts;
+  work.evaluations += r.evaluations;
+}
+
+}  // namespace
 
 void validate(const OnlineMatcherSettings& s) {
   validate(s.registration);
@@ -145,7 +162,9 @@ void OnlineMatcher::deskewScan(OnlineStep& step, const PointArray& points,
   const auto registered = [&](const Eigen::Isometry3d& increment) {
     return velocityOf(anchor * increment, interval);
   };
+  const auto start = std::chrono::steady_clock::now();
   for (int round = 0; round < settings_.deskew.iterations; ++round) {
+    ++step.work.deskew_rounds;
     // The pose at which every line lies on the reference (plane_polish.h), then a full
     // registration of the sweep re-placed there: the result the gate judges.
     const SweepPolishResult sp = registration_.polishSweep(points, times.tau, interval, placed, anchor,
@@ -154,6 +173,7 @@ void OnlineMatcher::deskewScan(OnlineStep& step, const PointArray& points,
     out = points;
     deskew(*out, times.tau, placed, registered(poseToIsometry(sp.pose)));
     RegistrationResult again = registration_.align(*out, sp.pose);
+    countAlign(step.work, again);
     if (!again.ok() || gate(again, step.guess, gate_settings) != GateReason::Accepted) break;
     const Eigen::Isometry3d change = step.increment.inverse() * again.transform;
     step.result = std::move(again);
@@ -166,6 +186,7 @@ void OnlineMatcher::deskewScan(OnlineStep& step, const PointArray& points,
   out = points;
   deskew(*out, times.tau, placed, registered(step.increment));
   step.deskewed = true;
+  step.work.deskew_s = secondsSince(start);
 }
 
 namespace {
@@ -192,6 +213,7 @@ OnlineStep OnlineMatcher::process(const PointArray& points, double stamp,
                                 " point times for " + std::to_string(points.size()) + " points");
   }
   if (!std::isfinite(stamp)) throw std::invalid_argument("process: the scan's stamp is not finite");
+  const auto start = std::chrono::steady_clock::now();
   OnlineStep step;
   const std::optional<Eigen::Isometry3d> odom = usableOdometry(given_odom, step);
   trackTime(stamp, step);
@@ -218,6 +240,7 @@ OnlineStep OnlineMatcher::process(const PointArray& points, double stamp,
   updateChain(step, deskewed ? *deskewed : points, stamp, odom, keyframe, refused);
   if (deskewed) step.deskewed_points = std::move(*deskewed);
   describe(step);
+  step.work.total_s = secondsSince(start);
   return step;
 }
 
@@ -298,14 +321,20 @@ void OnlineMatcher::registerAndGate(OnlineStep& step, const PointArray& points, 
   RegistrationSettings wide = settings_.registration;
   wide.gnmm.bounds *= step.gate_scale;
   if (step.gate_scale > 1.0) registration_.setSettings(wide);
+  auto start = std::chrono::steady_clock::now();
   step.result = registration_.align(points, step.guess);
+  countAlign(step.work, step.result);
+  step.work.register_s = secondsSince(start);
   if (!step.odometry_guess && settings_.constant_velocity && settings_.no_motion_candidate &&
       last_known_) {
     // Constant velocity fails where the motion changes most (a turn on the spot that starts,
     // stops or reverses): the no-motion guess is searched too, and the higher J wins.
     const Pose6 still = isometryToPose(keyframe.pose.inverse() * last_known_->pose);
     if ((still - step.guess).norm() > 1e-6) {
+      start = std::chrono::steady_clock::now();
       RegistrationResult other = registration_.align(points, still);
+      countAlign(step.work, other);
+      step.work.candidate_s = secondsSince(start);
       if (other.ok() && (!step.result.ok() || other.J > step.result.J)) {
         step.result = std::move(other);
         step.guess = still;
@@ -367,7 +396,13 @@ void OnlineMatcher::updateChain(OnlineStep& step, const PointArray& points, doub
                      (k.interval > 0.0 && stamp - keyframe->stamp >= k.interval);
     }
     std::string why;
-    if (new_keyframe && !addKeyframe(points, step.pose, stamp, why)) {
+    const auto start = std::chrono::steady_clock::now();
+    const bool added = new_keyframe && addKeyframe(points, step.pose, stamp, why);
+    if (new_keyframe) {
+      step.work.reference_built = added;
+      step.work.reference_s = secondsSince(start);
+    }
+    if (new_keyframe && !added) {
       if (first) step.reason = GateReason::BadReference;
       appendMessage(step, "scan not used as reference: " + why);
     } else {

@@ -94,6 +94,8 @@ struct Method {
   std::string name;
   Trajectory poses;
   std::vector<double> times;
+  /// Cube methods: each scan's work and its split of the time (online_matcher.h OnlineWork).
+  std::vector<OnlineWork> work;
   int accepted = 0, rejected = 0;
   /// Cube methods: per scan, whether it became a keyframe, and its pose's covariance along the
   /// chain (chain_covariance.h) for each of the benchmark's chain settings.
@@ -148,6 +150,7 @@ Method cubeMethod(const std::string& name, const OnlineMatcherSettings& settings
     const OnlineStep st = matcher->process(filterPoints(points, filter), stamp, odom);
     self.times.push_back(std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
     self.keyframe.push_back(st.reference_updated);
+    self.work.push_back(st.work);
     for (std::size_t i = 0; i < chains->size(); ++i) {
       const StepCovariance c = (*chains)[i].add(st);
       self.covariances[i].push_back(c.pose);
@@ -206,6 +209,45 @@ Method peerMethod(const std::string& name, PeerFn fn, double voxel, bool constan
     self.poses.push_back(rigidPart(pose));
   };
   return m;
+}
+
+/// A cube method's work per scan (online_matcher.h OnlineWork): the counts' means and
+/// maxima, and each stage's median and p95 time over the scans where it ran.
+void reportWork(const Method& m) {
+  std::vector<double> aligns, searches, rounds, register_s, candidate_s, deskew_s, reference_s;
+  for (const OnlineWork& w : m.work) {
+    aligns.push_back(w.aligns);
+    searches.push_back(w.searches);
+    rounds.push_back(w.deskew_rounds);
+    if (w.aligns > 0) register_s.push_back(w.register_s);
+    if (w.candidate_s > 0.0) candidate_s.push_back(w.candidate_s);
+    if (w.deskew_rounds > 0) deskew_s.push_back(w.deskew_s);
+    if (w.reference_built) reference_s.push_back(w.reference_s);
+  }
+  auto mean = [](const std::vector<double>& v) {
+    double sum = 0.0;
+    for (double x : v) sum += x;
+    return v.empty() ? 0.0 : sum / double(v.size());
+  };
+  auto max = [](const std::vector<double>& v) {
+    return v.empty() ? 0.0 : *std::max_element(v.begin(), v.end());
+  };
+  std::printf("%s work per scan: align() calls mean %.2f (max %.0f), full searches mean %.2f "
+              "(max %.0f), de-skew rounds mean %.2f (max %.0f)\n",
+              m.name.c_str(), mean(aligns), max(aligns), mean(searches), max(searches),
+              mean(rounds), max(rounds));
+  auto stage = [](const char* name, const std::vector<double>& v) {
+    if (v.empty()) {
+      std::printf("  %-22s never\n", name);
+    } else {
+      std::printf("  %-22s %4zu scans, median %.3f s, p95 %.3f s\n", name, v.size(),
+                  quantile(v, 0.5), quantile(v, 0.95));
+    }
+  };
+  stage("registration", register_s);
+  stage("no-motion candidate", candidate_s);
+  stage("de-skew rounds", deskew_s);
+  stage("keyframe submap", reference_s);
 }
 
 /// Each cube method's chain covariance against the truth at its keyframes (the chain's
@@ -413,6 +455,7 @@ int main(int argc, char** argv) {
         a.name = table[i].name + "-anchored";
         a.poses = table[i].anchored;
         a.times = table[i].times;
+        a.work = table[i].work;
         a.accepted = table[i].accepted, a.rejected = table[i].rejected;
         a.derived = true;
         table.push_back(std::move(a));
@@ -427,12 +470,21 @@ int main(int argc, char** argv) {
 
     CsvWriter csv(csv_path,
                   "label,odometry,method,scan,time_s,truth_x,truth_y,truth_z,truth_yaw_deg,x,y,z,"
-                  "yaw_deg");
+                  "yaw_deg,aligns,searches,evaluations,deskew_rounds,reference_built,register_s,"
+                  "candidate_s,deskew_s,reference_s");
     for (const Method& m : table) {
       for (std::size_t k = 0; k < truth.size(); ++k) {
         const Eigen::Vector3d t = truth[k].translation(), e = m.poses[k].translation();
         csv << label << odometry_mode << m.name << k << m.times[k] << t.x() << t.y() << t.z()
             << yawDeg(truth[k]) << e.x() << e.y() << e.z() << yawDeg(m.poses[k]);
+        if (k < m.work.size()) {  // a cube method: its work (the peers report time only)
+          const OnlineWork& w = m.work[k];
+          csv << w.aligns << w.searches << w.evaluations << w.deskew_rounds
+              << int(w.reference_built) << w.register_s << w.candidate_s << w.deskew_s
+              << w.reference_s;
+        } else {
+          for (int i = 0; i < 9; ++i) csv << "";
+        }
         csv.endRow();
       }
     }
@@ -441,7 +493,7 @@ int main(int argc, char** argv) {
       summary.emplace(summary_path,
                       "label,odometry,method,scans,length_m,accepted,rejected,rpe10_pct,"
                       "rpe10_deg_m,rpe50_pct,rpe50_deg_m,rpe100_pct,rpe100_deg_m,ate_m,"
-                      "still_scans,still_m,still_deg,median_time_s,max_error_m",
+                      "still_scans,still_m,still_deg,median_time_s,max_error_m,p95_time_s",
                       CsvWriter::Mode::Append);
     }
     const StationaryDrift still_truth = stationaryDrift(truth, truth);
@@ -449,9 +501,9 @@ int main(int argc, char** argv) {
     std::printf("%s, odometry %s: %zu scans, %.1f m, %d standing-still runs (%d scans)\n",
                 label.c_str(), odometry_mode.c_str(), truth.size(), travelled,
                 still_truth.segments, still_truth.scans);
-    std::printf("%-16s %6s %6s %14s %14s %14s %8s %8s %14s %9s\n", "method", "acc", "rej",
+    std::printf("%-16s %6s %6s %14s %14s %14s %8s %8s %14s %9s %9s\n", "method", "acc", "rej",
                 "RPE10 %|deg/m", "RPE50 %|deg/m", "RPE100 %|deg/m", "ATE m", "max m",
-                "still m|deg", "median s");
+                "still m|deg", "median s", "p95 s");
     std::vector<std::string> failures;
     for (const Method& m : table) {
       RelativeError r[3];
@@ -474,16 +526,16 @@ int main(int argc, char** argv) {
       char max_cell[32] = "-";
       if (std::isfinite(max_error)) std::snprintf(max_cell, sizeof max_cell, "%.3f", max_error);
       const StationaryDrift sd = stationaryDrift(truth, m.poses);
-      const double t_med = quantile(m.times, 0.5);
+      const double t_med = quantile(m.times, 0.5), t_p95 = quantile(m.times, 0.95);
       auto cell = [](const RelativeError& e) {
         char b[32];
         if (e.segments == 0) std::snprintf(b, sizeof b, "-");
         else std::snprintf(b, sizeof b, "%.2f|%.4f", e.translation_pct, e.rotation_deg_per_m);
         return std::string(b);
       };
-      std::printf("%-16s %6d %6d %14s %14s %14s %8.3f %8s %8.3f|%.2f %9.3f\n", m.name.c_str(),
+      std::printf("%-16s %6d %6d %14s %14s %14s %8.3f %8s %8.3f|%.2f %9.3f %9.3f\n", m.name.c_str(),
                   m.accepted, m.rejected, cell(r[0]).c_str(), cell(r[1]).c_str(), cell(r[2]).c_str(),
-                  ate, max_cell, sd.translation, sd.rotation_deg, t_med);
+                  ate, max_cell, sd.translation, sd.rotation_deg, t_med, t_p95);
       if (summary) {
         *summary << label << odometry_mode << m.name << truth.size() << travelled << m.accepted
                  << m.rejected;
@@ -494,6 +546,7 @@ int main(int argc, char** argv) {
         *summary << ate << sd.scans << sd.translation << sd.rotation_deg << t_med;
         if (std::isfinite(max_error)) *summary << max_error;
         else *summary << "";
+        *summary << t_p95;
         summary->endRow();
       }
       if (m.name.rfind("cubes", 0) == 0 && !m.derived) {
@@ -529,6 +582,9 @@ int main(int argc, char** argv) {
           failures.push_back(b);
         }
       }
+    }
+    for (const Method& m : table) {
+      if (!m.derived && !m.work.empty()) reportWork(m);
     }
     reportConsistency(table, truth, chain_settings, label, odometry_mode, seed, consistency_path);
     for (const std::string& f : failures) std::fprintf(stderr, "CHECK FAILED %s\n", f.c_str());

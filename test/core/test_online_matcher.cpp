@@ -52,6 +52,47 @@ TEST(OnlineMatcher, ChainsIncrementsFromBigOdometryErrors) {
   }
 }
 
+// OnlineStep::work counts what a step did: the first scan builds the reference and registers
+// nothing; a scan with odometry registers once (no no-motion candidate); one without
+// odometry also searches the no-motion candidate; the stage times add up to at most the total.
+TEST(OnlineMatcher, WorkCountsAndTimesEachStage) {
+  const sim::Scene scene = sim::Scene::generate(sim::SceneType::Urban, 4);
+  sim::RobotMotion robot(scene, sim::MotionSettings{}, 5);
+  std::mt19937_64 rng(7);
+  OnlineMatcherSettings every_scan;
+  every_scan.keyframes.distance = 0.0;  // every accepted scan becomes the keyframe
+  OnlineMatcher m(every_scan);
+  auto stagesWithinTotal = [](const OnlineWork& w) {
+    return w.register_s + w.candidate_s + w.deskew_s + w.reference_s <= w.total_s;
+  };
+  Eigen::Isometry3d truth = robot.pose();
+  OnlineStep s = m.process(scanInBase(scene, truth, rng), 1.0, truth);
+  EXPECT_EQ(s.work.aligns, 0);
+  EXPECT_TRUE(s.work.reference_built);
+  EXPECT_GT(s.work.reference_s, 0.0);
+  EXPECT_TRUE(stagesWithinTotal(s.work));
+
+  robot.advance();
+  truth = robot.pose();
+  s = m.process(scanInBase(scene, truth, rng), 2.0, truth);
+  ASSERT_EQ(s.reason, GateReason::Accepted) << s.message;
+  EXPECT_EQ(s.work.aligns, 1);
+  EXPECT_GE(s.work.searches, 1);
+  EXPECT_EQ(s.work.searches, s.result.attempts);
+  EXPECT_GT(s.work.evaluations, 0);
+  EXPECT_GT(s.work.register_s, 0.0);
+  EXPECT_EQ(s.work.candidate_s, 0.0);
+  EXPECT_EQ(s.work.deskew_rounds, 0);
+  EXPECT_TRUE(s.work.reference_built);
+  EXPECT_TRUE(stagesWithinTotal(s.work));
+
+  robot.advance();
+  s = m.process(scanInBase(scene, robot.pose(), rng), 3.0, std::nullopt);  // no odometry
+  EXPECT_EQ(s.work.aligns, 2) << "the prediction and the no-motion candidate";
+  EXPECT_GT(s.work.candidate_s, 0.0);
+  EXPECT_TRUE(stagesWithinTotal(s.work));
+}
+
 TEST(OnlineMatcher, TimeBackwardsResetsAndEmptyOrBadScansKeepTheReference) {
   const sim::Scene scene = sim::Scene::generate(sim::SceneType::Hall, 2);
   std::mt19937_64 rng(3);

@@ -79,6 +79,21 @@ struct OnlineMatcherSettings {
 void validate(const OnlineMatcherSettings& settings);
 
 /// What happened to one scan.
+/// The work one online step did and where its wall time went: what a robot pays per scan
+/// beyond a single registration (sequence_benchmark reports it per scan).
+struct OnlineWork {
+  int aligns = 0;       ///< Registration::align() calls: the scan, the no-motion candidate, de-skew rounds.
+  int searches = 0;     ///< full searches over those calls (RegistrationResult::attempts: 1 + retries used).
+  int evaluations = 0;  ///< objective evaluations over those calls.
+  int deskew_rounds = 0;        ///< de-skew rounds run (kept or not).
+  bool reference_built = false;  ///< the submap's grids were rebuilt (a new keyframe).
+  double register_s = 0.0;   ///< [s] the scan's registration from the guess.
+  double candidate_s = 0.0;  ///< [s] the no-motion candidate's (no odometry).
+  double deskew_s = 0.0;     ///< [s] the de-skew rounds (sweep polish, re-placing, registration).
+  double reference_s = 0.0;  ///< [s] the submap and its grids for a new keyframe.
+  double total_s = 0.0;      ///< [s] the whole process() call.
+};
+
 struct OnlineStep {
   GateReason reason = GateReason::FirstScan;
   bool registered = false;         ///< align() ran (a reference existed and the scan had points).
@@ -112,6 +127,7 @@ struct OnlineStep {
   int keyframes = 0;               ///< keyframes in the reference after this scan.
   Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();       ///< T_map_base of this scan.
   std::string message;             ///< why, for logs.
+  OnlineWork work;                 ///< what this step cost.
 };
 
 class OnlineMatcher {
