@@ -777,6 +777,34 @@ TEST_F(ScanMatcherSimTime, MapOdomNeverRepeatsAStamp) {
                                     << stamps.size() << " sent)";
 }
 
+// A bag replayed in a loop takes the clock back: the diagnostics go on at once (each tick is
+// forced) instead of staying silent until the clock is back where it was.
+TEST_F(ScanMatcherSimTime, DiagnosticsGoOnAfterTheClockJumpsBack) {
+  ros::Publisher clock_pub = nh.advertise<rosgraph_msgs::Clock>("/clock", 1, true);
+  std::vector<ros::Time> published;  // clock stamps of the matcher's diagnostics
+  ros::Subscriber sub = nh.subscribe<diagnostic_msgs::DiagnosticArray>(
+      "/diagnostics", 20, [&](const diagnostic_msgs::DiagnosticArray::ConstPtr& m) {
+        for (const auto& s : m->status) {
+          if (s.name.find("scan_matcher") != std::string::npos) published.push_back(m->header.stamp);
+        }
+      });
+  auto runClock = [&](double from, double seconds) {
+    for (double t = from; t <= from + seconds + 1e-9; t += 0.25) {
+      rosgraph_msgs::Clock c;
+      c.clock = ros::Time(t);
+      clock_pub.publish(c);
+      spinFor(0.1);
+    }
+  };
+  runClock(2000.0, 4.0);
+  const std::size_t before = published.size();
+  ASSERT_GE(before, 2u) << "no diagnostics on simulated time";
+  runClock(1500.0, 4.0);  // the loop: 500 s back
+  std::size_t after = 0;
+  for (std::size_t i = before; i < published.size(); ++i) after += published[i].toSec() < 1600.0;
+  EXPECT_GE(after, 2u) << "diagnostics silent for 4 s of simulated time after the clock went back";
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
