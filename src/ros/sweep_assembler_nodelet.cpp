@@ -484,7 +484,10 @@ void SweepAssemblerNodelet::diagnose(diagnostic_updater::DiagnosticStatusWrapper
   stat.add("tilt stalled", was_stalled_);
   stat.add("longest callback [s]", longest_call_s_);
   if (was_stalled_) {
-    stat.summary(DiagnosticStatus::WARN, "tilt stalled: lines are discarded");
+    stat.summary(DiagnosticStatus::WARN,
+                 std::string("tilt stalled: lines are discarded (no motion about tilt_axis ") +
+                     char('x' + params_.tilt_axis) + " of '" + params_.tilt_reference_frame +
+                     "' (tilt_reference_frame): if the laser moves, check both)");
   } else if (lines_dropped_tf_ + lines_lost_ + lines_late_ + lines_bad_ + sweeps_discarded_ > 0) {
     stat.summary(DiagnosticStatus::WARN, "some lines dropped or sweeps discarded");
   } else {

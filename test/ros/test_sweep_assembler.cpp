@@ -302,6 +302,33 @@ TEST_F(SweepAssemblerRos, OneExactCloudPerHalfPeriodAndALateLineIsDropped) {
   EXPECT_EQ(counter("lines dropped without tf") - dropped0, 0u);
 }
 
+/// The nodelet test only (test/ros/sweep_assembler.test): a second assembler on the same lines
+/// with the wrong tilt axis.
+class SweepAssemblerWrongAxis : public SweepAssemblerRos {};
+
+// An assembler given the wrong tilt axis (y, while the laser tilts about x) sees no tilt
+// motion: its stall WARN names tilt_axis and tilt_reference_frame, the settings to check.
+TEST_F(SweepAssemblerWrongAxis, StallsAndTheWarningNamesTheAxis) {
+  std::string wrong_axis_warning;
+  ros::Subscriber sub = nh.subscribe<diagnostic_msgs::DiagnosticArray>(
+      "/diagnostics", 50, [&](const diagnostic_msgs::DiagnosticArray::ConstPtr& m) {
+        for (const auto& s : m->status) {
+          if (s.name.find("sweep_assembler_wrong_axis: ") != std::string::npos &&
+              s.level == diagnostic_msgs::DiagnosticStatus::WARN) {
+            wrong_axis_warning = s.message;
+          }
+        }
+      });
+  publish(Schedule{});
+  ASSERT_TRUE(waitFor([&] { return !wrong_axis_warning.empty(); }, 10.0))
+      << "the assembler with tilt_axis y never warned";
+  EXPECT_NE(wrong_axis_warning.find("tilt stalled"), std::string::npos) << wrong_axis_warning;
+  EXPECT_NE(wrong_axis_warning.find("tilt_axis y"), std::string::npos) << wrong_axis_warning;
+  EXPECT_NE(wrong_axis_warning.find("'laser_mount' (tilt_reference_frame)"), std::string::npos)
+      << wrong_axis_warning;
+  EXPECT_GE(clouds.size(), 4u) << "the assembler with the right axis assembles the same lines";
+}
+
 TEST_F(SweepAssemblerRos, TfLateBy200msLosesNoLineAndOutOfOrderLinesAreSorted) {
   const std::uint64_t received0 = counter("lines received"), late0 = counter("lines late");
   const std::uint64_t dropped0 = counter("lines dropped without tf");
