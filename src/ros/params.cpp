@@ -225,12 +225,12 @@ NodeParams loadParams(const ros::NodeHandle& pnh) {
   else if (role == "map_odom") p.role = NodeParams::Role::MapOdom;
   else if (role == "anchored") p.role = NodeParams::Role::Anchored;
   else throw ParamError("parameter ~role = '" + role + "' must be messages, map_odom or anchored");
-  if (p.odom_frame.empty() && p.role != NodeParams::Role::Messages) {
+  if (!p.hasOdometry() && p.role != NodeParams::Role::Messages) {
     throw ParamError("parameter ~role = '" + role +
                      "' needs odometry (it sends map -> odom): with ~odom_frame empty (no "
                      "odometry) only role messages is possible");
   }
-  if (p.odom_frame.empty() && p.skip_without_tf) {
+  if (!p.hasOdometry() && p.skip_without_tf) {
     throw ParamError(
         "parameter ~missing_tf_policy = 'skip' with ~odom_frame empty (no odometry) would drop "
         "every scan: use predict");

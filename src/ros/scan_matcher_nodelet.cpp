@@ -89,10 +89,8 @@ void ScanMatcherNodelet::onInit() {
                   e.what());
     return;
   }
-  for (const std::string& w : unknownParamWarnings(privateParamNames(pnh), knownParamNames())) {
-    NODELET_WARN("%s", w.c_str());
-    param_warnings_ += (param_warnings_.empty() ? "" : "; ") + w;
-  }
+  param_warnings_ = unknownParamReport(pnh, knownParamNames());
+  if (!param_warnings_.empty()) NODELET_WARN("%s", param_warnings_.c_str());
   matcher_ = std::make_unique<OnlineMatcher>(params_.matcher);
   chain_ = std::make_unique<ChainCovariance>(params_.chain);
   anchor_ = std::make_unique<OdometryAnchor>(params_.anchor);
@@ -143,7 +141,7 @@ void ScanMatcherNodelet::onInit() {
       "ScanMatcherNodelet: registering %s in %s (odometry %s, poses in %s), E = %.2f m, "
       "SIMD path %s",
       cloud_sub_.getTopic().c_str(), params_.base_frame.c_str(),
-      params_.odom_frame.empty() ? "none: predicted" : params_.odom_frame.c_str(),
+      params_.hasOdometry() ? params_.odom_frame.c_str() : "none: predicted",
       params_.map_frame.c_str(), cube_edge, simdReport().c_str());
 }
 
@@ -297,7 +295,7 @@ std::string ScanMatcherNodelet::parseStart(const geometry_msgs::PoseWithCovarian
   // The pose holds at the request's stamp: the next scan's start is moved on by the odometry
   // from that stamp to its own (a zero stamp: the pose holds at the next scan).
   start.odom.reset();
-  if (!req.header.stamp.isZero() && !params_.odom_frame.empty()) {
+  if (!req.header.stamp.isZero() && params_.hasOdometry()) {
     std::string error;
     start.odom = lookup(params_.odom_frame, params_.base_frame, req.header.stamp, error);
     if (!start.odom && !stamp_is_approximate) {
@@ -529,7 +527,7 @@ bool ScanMatcherNodelet::lookupFrames(Scan& scan) {
   std::optional<Eigen::Isometry3d> T_base_cloud =
       frame == params_.base_frame ? std::optional<Eigen::Isometry3d>(Eigen::Isometry3d::Identity())
                                   : lookup(params_.base_frame, frame, stamp, tf_error);
-  const bool odometry = !params_.odom_frame.empty();  // "" = none: the motion model predicts
+  const bool odometry = params_.hasOdometry();
   if (odometry) scan.odom = lookup(params_.odom_frame, params_.base_frame, stamp, tf_error);
   if (scan.status.time_reset && (!T_base_cloud || (odometry && !scan.odom))) {
     // After a jump back by more than the tf cache, the buffer refuses the new (older) tf as

@@ -139,11 +139,8 @@ void SweepAssemblerNodelet::onInit() {
                   e.what());
     return;
   }
-  for (const std::string& w :
-       unknownParamWarnings(privateParamNames(pnh), knownAssemblerParamNames())) {
-    NODELET_WARN("%s", w.c_str());
-    param_warnings_ += (param_warnings_.empty() ? "" : "; ") + w;
-  }
+  param_warnings_ = unknownParamReport(pnh, knownAssemblerParamNames());
+  if (!param_warnings_.empty()) NODELET_WARN("%s", param_warnings_.c_str());
   cutter_ = std::make_unique<SweepCutter>(params_.cutter);
   // tf is kept 30 s: far more than any line waits (tf_timeout <= 10 s).
   tf_buffer_ = std::make_unique<tf2_ros::Buffer>(ros::Duration(30.0));

@@ -468,6 +468,7 @@ int main(int argc, char** argv) {
       table.push_back(std::move(o));
     }
 
+    constexpr int kWorkColumns = 9;  // aligns .. reference_s: blank for the peers
     CsvWriter csv(csv_path,
                   "label,odometry,method,scan,time_s,truth_x,truth_y,truth_z,truth_yaw_deg,x,y,z,"
                   "yaw_deg,aligns,searches,evaluations,deskew_rounds,reference_built,register_s,"
@@ -483,7 +484,7 @@ int main(int argc, char** argv) {
               << int(w.reference_built) << w.register_s << w.candidate_s << w.deskew_s
               << w.reference_s;
         } else {
-          for (int i = 0; i < 9; ++i) csv << "";
+          for (int i = 0; i < kWorkColumns; ++i) csv << "";
         }
         csv.endRow();
       }

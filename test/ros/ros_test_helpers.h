@@ -8,6 +8,7 @@
 #include <vector>
 
 #include <Eigen/Geometry>
+#include <diagnostic_msgs/DiagnosticArray.h>
 #include <geometry_msgs/PoseWithCovarianceStamped.h>
 #include <nav_msgs/Odometry.h>
 #include <nav_msgs/Path.h>
@@ -92,6 +93,15 @@ bool waitFor(F done, double timeout) {
   }
   ros::spinOnce();
   return done();
+}
+
+/// Every status published on /diagnostics, appended to `out` while the subscriber lives.
+inline ros::Subscriber collectDiagnostics(ros::NodeHandle& nh,
+                                          std::vector<diagnostic_msgs::DiagnosticStatus>& out) {
+  return nh.subscribe<diagnostic_msgs::DiagnosticArray>(
+      "/diagnostics", 10, [&out](const diagnostic_msgs::DiagnosticArray::ConstPtr& m) {
+        for (const auto& s : m->status) out.push_back(s);
+      });
 }
 
 /// Spins for `seconds` of wall time.

@@ -548,10 +548,7 @@ TEST_F(ScanMatcherAnchored, PullsTheChainTowardsTheOdometry) {
 TEST(ScanMatcherBadParam, RefusesToStartAndNamesTheParameter) {
   ros::NodeHandle nh;
   std::vector<diagnostic_msgs::DiagnosticStatus> diagnostics;
-  ros::Subscriber sub = nh.subscribe<diagnostic_msgs::DiagnosticArray>(
-      "/diagnostics", 10, [&](const diagnostic_msgs::DiagnosticArray::ConstPtr& m) {
-        for (const auto& s : m->status) diagnostics.push_back(s);
-      });
+  const ros::Subscriber sub = collectDiagnostics(nh, diagnostics);
   ASSERT_TRUE(waitFor([&] {
     for (const auto& d : diagnostics) {
       if (d.level == diagnostic_msgs::DiagnosticStatus::ERROR &&
@@ -606,10 +603,7 @@ TEST_F(ScanMatcherNoOdometry, RegistersFromThePredictionWithoutWaitingForTf) {
 TEST(ScanMatcherParamNames, MisspeltIsWarnedAndRenamedIsRefused) {
   ros::NodeHandle nh;
   std::vector<diagnostic_msgs::DiagnosticStatus> diagnostics;
-  ros::Subscriber sub = nh.subscribe<diagnostic_msgs::DiagnosticArray>(
-      "/diagnostics", 10, [&](const diagnostic_msgs::DiagnosticArray::ConstPtr& m) {
-        for (const auto& s : m->status) diagnostics.push_back(s);
-      });
+  const ros::Subscriber sub = collectDiagnostics(nh, diagnostics);
   auto seen = [&](const std::string& node, std::uint8_t level, const std::string& text) {
     for (const auto& d : diagnostics) {
       if (d.name.find(node) == std::string::npos || d.level != level) continue;

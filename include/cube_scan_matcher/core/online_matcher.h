@@ -78,7 +78,6 @@ struct OnlineMatcherSettings {
 /// Throws std::invalid_argument naming the bad setting.
 void validate(const OnlineMatcherSettings& settings);
 
-/// What happened to one scan.
 /// The work one online step did and where its wall time went: what a robot pays per scan
 /// beyond a single registration (sequence_benchmark reports it per scan).
 struct OnlineWork {
@@ -94,6 +93,7 @@ struct OnlineWork {
   double total_s = 0.0;      ///< [s] the whole process() call.
 };
 
+/// What happened to one scan.
 struct OnlineStep {
   GateReason reason = GateReason::FirstScan;
   bool registered = false;         ///< align() ran (a reference existed and the scan had points).

@@ -22,6 +22,8 @@ struct NodeParams {
   std::string base_frame = "base_link";  ///< robot frame the scans are registered in.
   std::string odom_frame = "odom";       ///< frame of the DGPS/IMU odometry; "" = none.
   std::string map_frame = "map";         ///< frame of the published poses and clouds.
+  /// A robot without odometry (odom_frame ""): no lookup, the motion model predicts each scan.
+  bool hasOdometry() const { return !odom_frame.empty(); }
   // tf.
   double tf_timeout = 0.1;        ///< [s] bounded wait for each tf lookup, in [0, 10].
   /// [s] a scan stamped earlier than the last one by less than this is out of order: dropped

@@ -87,4 +87,15 @@ inline std::vector<std::string> privateParamNames(const ros::NodeHandle& pnh) {
   return names;
 }
 
+/// unknownParamWarnings for the names set under `pnh`, joined with "; " ("" = none): what a
+/// nodelet logs at start and keeps in its diagnostics.
+inline std::string unknownParamReport(const ros::NodeHandle& pnh,
+                                      const std::vector<std::string>& known) {
+  std::string report;
+  for (const std::string& w : unknownParamWarnings(privateParamNames(pnh), known)) {
+    report += (report.empty() ? "" : "; ") + w;
+  }
+  return report;
+}
+
 }  // namespace cube_scan_matcher
