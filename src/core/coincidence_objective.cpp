@@ -11,18 +11,18 @@ CoincidenceObjective::CoincidenceObjective(const CubeGrid& grid) : grid_(&grid),
 }
 
 void CoincidenceObjective::initWorkingCopy() {
-  // The working copy is all zero on entry (new, or cleared by setGrid), so only growth is
-  // written: 1 for each set cube of L, and a spare always-zero cube past the grid into which
-  // outside points index.
+  // Both copies are all zero on entry (new, or cleared by setGrid), so only growth is written:
+  // 1 for each set cube of L, and a spare always-zero cube past the grid into which outside
+  // points index. The copy of the other mode keeps its memory (all zero): a reference whose
+  // size crosses max_byte_cubes and back does not allocate and fault in fresh pages.
   const CubeGrid& grid = *grid_;
-  if (grid.bytePerCube()) {
-    std::vector<std::uint64_t>().swap(bits_);
+  byte_mode_ = grid.bytePerCube();
+  if (byte_mode_) {
     outside_ = std::int32_t(grid.cubeCount());
     reserveForRebuild(bytes_, std::size_t(grid.cubeCount()) + 1);  // all zero, or dropped
     bytes_.resize(std::size_t(grid.cubeCount()) + 1, 0);
     for (std::int32_t c : grid.list()) bytes_[std::size_t(c)] = 1;
   } else {
-    std::vector<std::uint8_t>().swap(bytes_);
     const std::size_t words = grid.bits().size();
     outside_ = std::int32_t(words * 64);
     reserveForRebuild(bits_, words + 1);

@@ -249,9 +249,11 @@ CubeGrid CubeGrid::build(const PointArray& ref, const CubeGridSettings& settings
 
 void CubeGrid::rebuild(const PointArray& ref, const CubeGridSettings& settings) {
   validate(settings);
-  // Empty until it is complete: an error leaves no half-built grid.
+  // Empty until it is complete: an error leaves no half-built grid. V is zeroed through L, in
+  // O(l) and not O(v): the rest of it is zero already, and its memory (written before) serves
+  // the new grid.
+  for (const std::int32_t c : list_) bits_[std::size_t(c) >> 6] = 0;
   list_.clear();
-  bits_.clear();
   dims_.setZero();
   dims_f_.setZero();
   if (ref.empty()) {
@@ -302,7 +304,7 @@ void CubeGrid::rebuild(const PointArray& ref, const CubeGridSettings& settings) 
   dims_ = dims;
   dims_f_ = dims_.cast<float>();
   reserveForRebuild(bits_, (cubeCount() + 63) / 64);
-  bits_.assign((cubeCount() + 63) / 64, 0);
+  bits_.resize((cubeCount() + 63) / 64, 0);  // all zero: only growth is written
   // Indices a block at a time (no index array the size of the scan to allocate).
   constexpr std::size_t kBlock = 1024;
   std::int32_t idx[kBlock];

@@ -25,6 +25,9 @@ void countAlign(OnlineWork& work, const RegistrationResult& r) {
   ++work.aligns;
   work.searches += r.attempts;
   work.evaluations += r.evaluations;
+  work.coarse_s += r.time_coarse_s;
+  work.refine_s += r.time_refine_s;
+  work.polish_s += r.time_polish_s;
 }
 
 }  // namespace

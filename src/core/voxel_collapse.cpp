@@ -13,9 +13,13 @@ namespace cube_scan_matcher {
 PointArray collapseToVoxels(const PointArray& in, double voxel) {
   if (!(voxel > 0.0)) throw std::invalid_argument("collapse voxel must be > 0 m");
   const float inv = float(1.0 / voxel);
-  // A tilting scanner's sweep has some 10 points per E/4 voxel: the map starts there.
-  detail::KeyIndex set(in.size() / 8);
-  std::vector<std::uint32_t> keep;
+  // A tilting scanner's sweep has some 10 points per E/4 voxel: the map starts there. The
+  // table and the kept indices are the thread's own from call to call: fresh ones of a few
+  // hundred kB per scan would be faulted in page by page (core/large_buffer.h).
+  thread_local detail::KeyIndex set;
+  thread_local std::vector<std::uint32_t> keep;
+  set.reset(in.size() / 8);
+  keep.clear();
   keep.reserve(in.size() / 8);
   detail::forEachVoxelKey(in, inv, [&](std::size_t i, std::uint64_t key) {
     if (set.insert(key).second) keep.push_back(std::uint32_t(i));

@@ -214,8 +214,15 @@ Method peerMethod(const std::string& name, PeerFn fn, double voxel, bool constan
 /// A cube method's work per scan (online_matcher.h OnlineWork): the counts' means and
 /// maxima, and each stage's median and p95 time over the scans where it ran.
 void reportWork(const Method& m) {
-  std::vector<double> aligns, searches, rounds, register_s, candidate_s, deskew_s, reference_s;
+  std::vector<double> aligns, searches, rounds, register_s, candidate_s, deskew_s, reference_s,
+      coarse_s, refine_s, polish_s, total_s;
   for (const OnlineWork& w : m.work) {
+    total_s.push_back(w.total_s);
+    if (w.aligns > 0) {
+      coarse_s.push_back(w.coarse_s);
+      refine_s.push_back(w.refine_s);
+      polish_s.push_back(w.polish_s);
+    }
     aligns.push_back(w.aligns);
     searches.push_back(w.searches);
     rounds.push_back(w.deskew_rounds);
@@ -248,6 +255,11 @@ void reportWork(const Method& m) {
   stage("no-motion candidate", candidate_s);
   stage("de-skew rounds", deskew_s);
   stage("keyframe submap", reference_s);
+  std::printf("  in the align() calls:\n");
+  stage("  coarse search", coarse_s);
+  stage("  refine", refine_s);
+  stage("  polish", polish_s);
+  stage("whole step", total_s);
 }
 
 /// Each cube method's chain covariance against the truth at its keyframes (the chain's
@@ -468,11 +480,11 @@ int main(int argc, char** argv) {
       table.push_back(std::move(o));
     }
 
-    constexpr int kWorkColumns = 9;  // aligns .. reference_s: blank for the peers
+    constexpr int kWorkColumns = 12;  // aligns .. polish_s: blank for the peers
     CsvWriter csv(csv_path,
                   "label,odometry,method,scan,time_s,truth_x,truth_y,truth_z,truth_yaw_deg,x,y,z,"
                   "yaw_deg,aligns,searches,evaluations,deskew_rounds,reference_built,register_s,"
-                  "candidate_s,deskew_s,reference_s");
+                  "candidate_s,deskew_s,reference_s,coarse_s,refine_s,polish_s");
     for (const Method& m : table) {
       for (std::size_t k = 0; k < truth.size(); ++k) {
         const Eigen::Vector3d t = truth[k].translation(), e = m.poses[k].translation();
@@ -482,7 +494,7 @@ int main(int argc, char** argv) {
           const OnlineWork& w = m.work[k];
           csv << w.aligns << w.searches << w.evaluations << w.deskew_rounds
               << int(w.reference_built) << w.register_s << w.candidate_s << w.deskew_s
-              << w.reference_s;
+              << w.reference_s << w.coarse_s << w.refine_s << w.polish_s;
         } else {
           for (int i = 0; i < kWorkColumns; ++i) csv << "";
         }

@@ -123,3 +123,29 @@ TEST(CoincidenceObjective, SetGridGivesTheSameJAsAFreshObjective) {
     EXPECT_TRUE(moving.workingCopyRestored());
   }
 }
+
+TEST(CoincidenceObjective, SwitchingBetweenByteAndBitGridsGivesTheSameJ) {
+  // A byte-mode grid, then a bit-mode one, and back twice: the copy of the other mode keeps its
+  // memory, and must stay all zero meanwhile.
+  const PointArray a = wavySurface(3000, 0.f), b = wavySurface(2500, 1.3f);
+  CubeGridSettings bytes = edge(0.5), bits = edge(0.3);
+  bytes.max_byte_cubes = std::uint64_t{1} << 22;
+  bits.max_byte_cubes = 0;
+  const CubeGrid ga = CubeGrid::build(a, bytes), gb = CubeGrid::build(b, bits);
+  CoincidenceObjective moving(ga, a);
+  ASSERT_TRUE(moving.bytePerCube());
+  for (int round = 0; round < 2; ++round) {
+    moving.setGrid(gb);
+    moving.setScan(a);
+    EXPECT_FALSE(moving.bytePerCube());
+    CoincidenceObjective fresh_b(gb, a);
+    for (double dx : {0.0, 0.2, -0.7}) EXPECT_EQ(moving(shift(dx)), fresh_b(shift(dx))) << dx;
+    EXPECT_TRUE(moving.workingCopyRestored());
+    moving.setGrid(ga);
+    moving.setScan(b);
+    EXPECT_TRUE(moving.bytePerCube());
+    CoincidenceObjective fresh_a(ga, b);
+    for (double dx : {0.0, 0.2, -0.7}) EXPECT_EQ(moving(shift(dx)), fresh_a(shift(dx))) << dx;
+    EXPECT_TRUE(moving.workingCopyRestored());
+  }
+}

@@ -194,3 +194,39 @@ TEST(SimdPath, NamesParseAndBadOnesAreRefused) {
   }
   EXPECT_NE(simdReport().find(simdPathName(activeSimdPath())), std::string::npos);
 }
+
+TEST(LargeBuffer, BigBlocksStartOnAHugePageAndKeepTheirContents) {
+  LargeBuffer<std::uint64_t> big(300000, 7);  // 2.4 MB
+  EXPECT_EQ(reinterpret_cast<std::uintptr_t>(big.data()) % LargeBufferAllocator<std::uint64_t>::kHugePage, 0u);
+  big.resize(600000, 9);  // grows into a new block: the old contents are copied
+  EXPECT_EQ(big[299999], 7u);
+  EXPECT_EQ(big[300000], 9u);
+  LargeBuffer<std::uint8_t> small(100, 3);  // an ordinary block
+  EXPECT_EQ(std::count(small.begin(), small.end(), 3), 100);
+}
+
+TEST(CubeGrid, RebuiltAfterALargerGridAndAnErrorEqualsAFreshOne) {
+  // V is zeroed through L, not wholesale: a rebuild into the memory of a larger grid, and one
+  // after a refused extent, must leave no stale bit.
+  std::mt19937 rng(5);
+  std::uniform_real_distribution<float> u(-20.f, 20.f), s(-3.f, 3.f);
+  PointArray big, small;
+  for (int i = 0; i < 20000; ++i) big.push_back(u(rng), u(rng), u(rng) / 4);
+  for (int i = 0; i < 3000; ++i) small.push_back(s(rng), s(rng), s(rng));
+  const CubeGridSettings settings = edge(0.25);
+  CubeGrid reused = CubeGrid::build(big, settings);
+  PointArray absurd = small;
+  absurd.push_back(1e6f, 0.f, 0.f);
+  EXPECT_THROW(reused.rebuild(absurd, settings), CubeGridError);
+  EXPECT_EQ(reused.occupiedCount(), 0u);
+  reused.rebuild(small, settings);
+  const CubeGrid fresh = CubeGrid::build(small, settings);
+  EXPECT_EQ(reused.dims(), fresh.dims());
+  EXPECT_EQ(reused.list(), fresh.list());
+  ASSERT_EQ(reused.bits().size(), fresh.bits().size());
+  EXPECT_TRUE(std::equal(fresh.bits().begin(), fresh.bits().end(), reused.bits().begin()));
+  reused.rebuild(big, settings);  // and growing again within the kept memory
+  const CubeGrid fresh_big = CubeGrid::build(big, settings);
+  EXPECT_EQ(reused.list(), fresh_big.list());
+  EXPECT_TRUE(std::equal(fresh_big.bits().begin(), fresh_big.bits().end(), reused.bits().begin()));
+}

@@ -47,7 +47,7 @@ class CoincidenceObjective {
   /// True if the working copy of V equals the grid's V (it must, between evaluations).
   bool workingCopyRestored() const;
   /// The working copy holds a byte per cube (else a bit per cube, as V).
-  bool bytePerCube() const { return !bytes_.empty(); }
+  bool bytePerCube() const { return byte_mode_; }
   /// Heap bytes of the working copy of V and the index buffers.
   std::size_t memoryBytes() const {
     return bytes_.capacity() + bits_.capacity() * sizeof(std::uint64_t) +
@@ -66,9 +66,11 @@ class CoincidenceObjective {
   const CubeGrid* grid_;
   const PointArray* scan_ = nullptr;
   // The working copy of V with a spare always-zero cube past the grid, into which outside
-  // points index: one byte per cube (grids up to max_byte_cubes) or one bit per cube.
-  std::vector<std::uint8_t> bytes_;
-  std::vector<std::uint64_t> bits_;
+  // points index: one byte per cube (grids up to max_byte_cubes) or one bit per cube. The
+  // copy not in use is kept all zero (its memory serves the next grid of that mode).
+  LargeBuffer<std::uint8_t> bytes_;
+  LargeBuffer<std::uint64_t> bits_;
+  bool byte_mode_ = false;
   std::vector<std::int32_t> hits_;  // bit mode: indices cleared in this evaluation (J of them)
   std::vector<std::int32_t> idx_;   // block of cube indices
   std::int32_t outside_ = 0;        // index of the spare zero cube

@@ -14,6 +14,7 @@
 
 #include <Eigen/Core>
 
+#include "cube_scan_matcher/core/large_buffer.h"
 #include "cube_scan_matcher/core/point_array.h"
 
 namespace cube_scan_matcher {
@@ -84,7 +85,7 @@ class CubeGrid {
   bool occupied(std::int64_t index) const {
     return index >= 0 && ((bits_[std::size_t(index) >> 6] >> (index & 63)) & 1u);
   }
-  const std::vector<std::uint64_t>& bits() const { return bits_; }
+  const LargeBuffer<std::uint64_t>& bits() const { return bits_; }
   const std::vector<std::int32_t>& list() const { return list_; }
   /// Heap bytes of V and L.
   std::size_t memoryBytes() const {
@@ -103,7 +104,7 @@ class CubeGrid {
   Eigen::Vector3d max_ = Eigen::Vector3d::Zero();
   Eigen::Vector3i dims_ = Eigen::Vector3i::Zero();
   Eigen::Vector3f dims_f_ = Eigen::Vector3f::Zero();
-  std::vector<std::uint64_t> bits_;  ///< V, 64 cubes per word.
+  LargeBuffer<std::uint64_t> bits_;  ///< V, 64 cubes per word.
   std::vector<std::int32_t> list_;   ///< L, unsorted indices of set cubes.
 };
 

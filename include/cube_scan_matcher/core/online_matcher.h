@@ -91,6 +91,9 @@ struct OnlineWork {
   double deskew_s = 0.0;     ///< [s] the de-skew rounds (sweep polish, re-placing, registration).
   double reference_s = 0.0;  ///< [s] the submap and its grids for a new keyframe.
   double total_s = 0.0;      ///< [s] the whole process() call.
+  /// [s] Inside every align() call of the step (registration, candidate, de-skew rounds): the
+  /// coarse GNMM search, the refine and the polish (RegistrationResult::time_*_s).
+  double coarse_s = 0.0, refine_s = 0.0, polish_s = 0.0;
 };
 
 /// What happened to one scan.
