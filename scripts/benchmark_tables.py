@@ -505,6 +505,41 @@ def sequences(out):
     finally:
         os.unlink(tmp.name)
     print()
+    work_table(folder)
+
+
+def work_table(folder):
+    """Where the online step's time goes: the cube method's work columns per scan."""
+    print("### Where the online step's time goes (the cube method, every scan)\n")
+    print("Medians over the scans that ran the stage (count in brackets); coarse, refine and "
+          "polish inside all align() calls of the step.\n")
+    print("| run | odometry | align() calls / full searches per scan (mean) | registration | "
+          "no-motion candidate | keyframe submap, median / p95 | coarse | refine | polish | "
+          "whole step, median / p95 |")
+    print("|---|---|---|---|---|---|---|---|---|---|")
+    ms = lambda v: "%.1f ms" % (1e3 * v)  # noqa: E731
+    for path in files(folder, r"(sim_(big|cv)_\w+|real_\w+)\.csv"):
+        rows = [r for r in read_rows(path) if r["method"] == "cubes" and r.get("aligns") not in (None, "")]
+        if not rows or value(rows[0], "coarse_s") is None:
+            continue
+        ran = [r for r in rows if int(r["aligns"]) > 0]
+
+        def med(key, sel):
+            v = [float(r[key]) for r in sel]
+            return "%s (%d)" % (ms(quantile(v, 0.5)), len(v)) if v else "never"
+        cand = [r for r in rows if float(r["candidate_s"]) > 0]
+        ref = [float(r["reference_s"]) for r in rows if r["reference_built"] == "1"]
+        step = [float(r["time_s"]) for r in rows]
+        label = os.path.basename(path)[:-4]
+        print("| %s | %s | %.2f / %.2f | %s | %s | %s | %s | %s | %s | %s / %s |" % (
+            label, rows[0]["odometry"],
+            statistics.mean(int(r["aligns"]) for r in rows),
+            statistics.mean(int(r["searches"]) for r in rows),
+            med("register_s", ran), med("candidate_s", cand),
+            "%s / %s (%d)" % (ms(quantile(ref, 0.5)), ms(quantile(ref, 0.95)), len(ref)) if ref else "never",
+            med("coarse_s", ran), med("refine_s", ran), med("polish_s", ran),
+            ms(quantile(step, 0.5)), ms(quantile(step, 0.95))))
+    print()
 
 
 # --- sweeps ------------------------------------------------------------------------------------

@@ -22,18 +22,21 @@ def table(path):
     def cell(pct, deg):
         return "-" if pct == "" else "%.2f %% / %.4f" % (float(pct), float(deg))
 
+    def p95(r):  # summaries written before the column have none
+        return "-" if r.get("p95_time_s") in (None, "") else "%.3f" % float(r["p95_time_s"])
+
     print("| run | odometry | method | scans | m | accepted / rejected | RPE 10 m | RPE 50 m | "
-          "RPE 100 m | ATE m | standing still m / deg | median s |")
-    print("|---|---|---|---|---|---|---|---|---|---|---|---|")
+          "RPE 100 m | ATE m | standing still m / deg | median s | p95 s |")
+    print("|---|---|---|---|---|---|---|---|---|---|---|---|---|")
     with open(path) as fh:
         for r in csv.DictReader(fh):
-            print("| %s | %s | %s | %s | %.0f | %s / %s | %s | %s | %s | %.3f | %s | %.3f |" % (
+            print("| %s | %s | %s | %s | %.0f | %s / %s | %s | %s | %s | %.3f | %s | %.3f | %s |" % (
                 r["label"], r["odometry"], r["method"], r["scans"], float(r["length_m"]),
                 r["accepted"], r["rejected"], cell(r["rpe10_pct"], r["rpe10_deg_m"]),
                 cell(r["rpe50_pct"], r["rpe50_deg_m"]), cell(r["rpe100_pct"], r["rpe100_deg_m"]),
                 float(r["ate_m"]),
                 "-" if r["still_scans"] == "0" else "%.3f / %.2f" % (float(r["still_m"]), float(r["still_deg"])),
-                float(r["median_time_s"])))
+                float(r["median_time_s"]), p95(r)))
 
 
 def planar(r, prefix):
