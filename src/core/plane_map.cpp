@@ -2,6 +2,7 @@
 
 #include <cmath>
 #include <stdexcept>
+#include <thread>
 
 #include <Eigen/Eigenvalues>
 
@@ -55,13 +56,17 @@ void PlaneMap::rebuild(const PointArray& reference, double voxel, int min_points
     s.sum += p;
     s.outer += p * p.transpose();
   }
-  reserveForRebuild(fit_, stats_.size());
-  fit_.assign(stats_.size(), Fit::Unknown);
+  if (stats_.size() > fit_capacity_) {
+    fit_capacity_ = stats_.size() + stats_.size() / 2;  // headroom: the next reference's size
+    fit_ = std::make_unique<std::atomic<std::uint8_t>[]>(fit_capacity_);
+  }
+  for (std::size_t k = 0; k < stats_.size(); ++k) fit_[k].store(kUnknown, std::memory_order_relaxed);
   reserveForRebuild(planes_, stats_.size());
   planes_.resize(stats_.size());
 }
 
-void PlaneMap::fit(std::size_t index, std::int64_t ix, std::int64_t iy, std::int64_t iz) const {
+std::uint8_t PlaneMap::fit(std::size_t index, std::int64_t ix, std::int64_t iy,
+                          std::int64_t iz) const {
   Stats block;
   for (std::int64_t dz = -1; dz <= 1; ++dz) {
     for (std::int64_t dy = -1; dy <= 1; ++dy) {
@@ -79,15 +84,14 @@ void PlaneMap::fit(std::size_t index, std::int64_t ix, std::int64_t iy, std::int
       }
     }
   }
-  fit_[index] = Fit::None;
-  if (block.n < double(min_points_)) return;
+  if (block.n < double(min_points_)) return kNone;
   const Eigen::Vector3d mean = block.sum / block.n;
   const Eigen::Matrix3d cov = block.outer / block.n - mean * mean.transpose();
   Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig;
   eig.computeDirect(cov);
   const Eigen::Vector3d& l = eig.eigenvalues();  // increasing
-  if (!(l(0) <= max_planarity_ * l(1)) || !(l(1) > 0.0)) return;
-  if (l(1) < min_spread_ * min_spread_ * voxel_ * voxel_) return;
+  if (!(l(0) <= max_planarity_ * l(1)) || !(l(1) > 0.0)) return kNone;
+  if (l(1) < min_spread_ * min_spread_ * voxel_ * voxel_) return kNone;
   // The offset is the mean of the voxel's own points: on a curved surface (a tree's canopy, a
   // pillar) the mean of the whole block lies a sagitta inside the surface, and every point
   // near it would be pulled towards the centre of curvature (a bias along the direction the
@@ -95,7 +99,23 @@ void PlaneMap::fit(std::size_t index, std::int64_t ix, std::int64_t iy, std::int
   const Stats& own = stats_[index];
   planes_[index].mean = own.sum / own.n;
   planes_[index].normal = eig.eigenvectors().col(0).normalized();
-  fit_[index] = Fit::Plane;
+  return kPlane;
+}
+
+std::uint8_t PlaneMap::fitOnce(std::size_t index, std::int64_t ix, std::int64_t iy,
+                               std::int64_t iz) const {
+  std::atomic<std::uint8_t>& state = fit_[index];
+  std::uint8_t seen = kUnknown;
+  if (state.compare_exchange_strong(seen, kFitting, std::memory_order_acquire)) {
+    const std::uint8_t result = fit(index, ix, iy, iz);
+    state.store(result, std::memory_order_release);
+    return result;
+  }
+  while (seen == kFitting) {  // another thread fits it (a few microseconds)
+    std::this_thread::yield();
+    seen = state.load(std::memory_order_acquire);
+  }
+  return seen;
 }
 
 const LocalPlane* PlaneMap::planeAt(const Eigen::Vector3d& q) const {
@@ -110,14 +130,16 @@ const LocalPlane* PlaneMap::planeOfVoxel(std::int64_t ix, std::int64_t iy, std::
   }
   const std::uint32_t index = keys_->find(detail::packVoxel(ix, iy, iz));
   if (index == detail::KeyIndex::kNone) return nullptr;
-  if (fit_[index] == Fit::Unknown) fit(index, ix, iy, iz);
-  return fit_[index] == Fit::Plane ? &planes_[index] : nullptr;
+  std::uint8_t state = fit_[index].load(std::memory_order_acquire);
+  if (state == kUnknown || state == kFitting) state = fitOnce(index, ix, iy, iz);
+  return state == kPlane ? &planes_[index] : nullptr;
 }
 
 std::size_t PlaneMap::memoryBytes() const {
   return (keys_ ? keys_->memoryBytes() : 0) + stats_.capacity() * sizeof(Stats) +
          voxel_of_.capacity() * sizeof(std::uint32_t) +
-         fit_.capacity() * sizeof(Fit) + planes_.capacity() * sizeof(LocalPlane);
+         fit_capacity_ * sizeof(std::atomic<std::uint8_t>) +
+         planes_.capacity() * sizeof(LocalPlane);
 }
 
 }  // namespace cube_scan_matcher

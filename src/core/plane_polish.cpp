@@ -9,6 +9,7 @@
 #include <Eigen/Geometry>
 
 #include "cube_scan_matcher/core/deskew.h"
+#include "cube_scan_matcher/core/parallel.h"
 #include "require_in_range.h"
 #include "voxel_key.h"
 
@@ -126,45 +127,80 @@ struct Corners {
   std::array<const LocalPlane*, 8> planes{};
 };
 
+/// The lowest of the 8 voxel centres around q (PlaneMap::planeOfVoxel indices) in b, and per
+/// axis the trilinear weights of the lower and the upper centre in g. `inv`: 1 / voxel edge.
+inline void cornerBase(const Eigen::Vector3d& q, double inv, std::int64_t b[3], double g[3][2]) {
+  // Voxel k's centre is at (k + 1/2) / inv: u = q inv - 1/2 has the lower centre at floor(u).
+  for (int k = 0; k < 3; ++k) {
+    const double u = q[k] * inv - 0.5;
+    const double lower = std::floor(u);
+    const double f = u - lower;
+    g[k][0] = 1.0 - f, g[k][1] = f;
+    b[k] = std::int64_t(std::clamp(lower, -double(1 << 20), double(1 << 20))) + (1 << 20);
+  }
+}
+
+/// Sets c to the planes of the 8 voxels from b on, unless it already holds them.
+inline void lookUpCorners(const PlaneMap& map, const std::int64_t b[3], Corners& c) {
+  const std::uint64_t base = detail::packVoxel(b[0], b[1], b[2]);
+  if (c.base == base) return;
+  c.base = base;
+  for (int k = 0; k < 8; ++k) {
+    c.planes[std::size_t(k)] =
+        map.planeOfVoxel(b[0] + (k & 1), b[1] + ((k >> 1) & 1), b[2] + ((k >> 2) & 1));
+  }
+}
+
+/// Looks up every point's corners (and so fits the planes they need) on `threads` threads:
+/// the lookups and the lazy plane fits are most of a pass over every scan point, and the
+/// serial pass that follows then finds each point's corners in place. The result does not
+/// depend on the threads: each point's corners are the same whoever looks them up.
+void lookUpCornersInParallel(const PlaneMap& map, const PointArray& scan, const Eigen::Matrix3d& R,
+                             const Eigen::Vector3d& t, std::vector<Corners>& corners,
+                             int threads) {
+  constexpr std::size_t kChunk = 1024;  // points per job
+  const int jobs = int((scan.size() + kChunk - 1) / kChunk);
+  const double inv = map.inverseVoxel();
+  runOnThreads(jobs, threads, [&](int job, int) {
+    const std::size_t end = std::min(scan.size(), (std::size_t(job) + 1) * kChunk);
+    for (std::size_t i = std::size_t(job) * kChunk; i < end; ++i) {
+      const Eigen::Vector3d rp = R * scan.point(i).cast<double>();
+      const Eigen::Vector3d q = rp + t;
+      std::int64_t b[3];
+      double g[3][2];
+      cornerBase(q, inv, b, g);
+      lookUpCorners(map, b, corners[i]);
+    }
+  });
+}
+
 /// Trilinear correspondences: each scan point is paired with the planes of the 8 voxels whose
 /// centres surround q, each weighted by q's trilinear weight for that centre (they sum to 1).
 /// The weights vary continuously with the pose, so the objective has no steps where a point
 /// crosses a voxel face: a polish started a centimetre apart ends on the same pose.
 /// `corners[i]` caches point i's planes; they are looked up again only when q moves into
 /// another set of 8 voxels. With `near`, collects the points that have a plane among their 8
-/// (and their corners, in `near_corners`).
+/// (and their corners, in `near_corners`). With threads > 1 the corners are looked up on that
+/// many threads first (lookUpCornersInParallel); the sums are the same, in the same order.
 Linearisation lineariseTrilinear(const PlaneMap& map, const PointArray& scan,
                                  const Eigen::Matrix3d& R, const Eigen::Vector3d& t,
                                  double kernel, std::vector<Corners>& corners,
                                  PointArray* near = nullptr,
-                                 std::vector<Corners>* near_corners = nullptr) {
+                                 std::vector<Corners>* near_corners = nullptr, int threads = 1) {
   Linearisation L;
   const double k2 = kernel * kernel;
   const double max_r = map.voxel();
   const double inv = map.inverseVoxel();
   corners.resize(scan.size());
+  if (threads > 1) lookUpCornersInParallel(map, scan, R, t, corners, threads);
   for (std::size_t i = 0; i < scan.size(); ++i) {
     const Eigen::Vector3d rp = R * scan.point(i).cast<double>();
     const Eigen::Vector3d q = rp + t;
-    // Voxel k's centre is at (k + 1/2) / inv: u = q inv - 1/2 has the lower centre at floor(u).
     std::int64_t b[3];
     double g[3][2];  // per axis: the weights of the lower and the upper centre
-    for (int k = 0; k < 3; ++k) {
-      const double u = q[k] * inv - 0.5;
-      const double lower = std::floor(u);
-      const double f = u - lower;
-      g[k][0] = 1.0 - f, g[k][1] = f;
-      b[k] = std::int64_t(std::clamp(lower, -double(1 << 20), double(1 << 20))) + (1 << 20);
-    }
+    cornerBase(q, inv, b, g);
     Corners& c = corners[i];
-    const std::uint64_t base = detail::packVoxel(b[0], b[1], b[2]);
-    if (c.base != base) {
-      c.base = base;
-      for (int k = 0; k < 8; ++k) {
-        c.planes[std::size_t(k)] = map.planeOfVoxel(b[0] + (k & 1), b[1] + ((k >> 1) & 1),
-                                                    b[2] + ((k >> 2) & 1));
-      }
-    }
+    lookUpCorners(map, b, c);
     bool any_plane = false, any = false;
     for (int k = 0; k < 8; ++k) {
       const LocalPlane* plane = c.planes[std::size_t(k)];
@@ -305,7 +341,7 @@ struct Iterated {
 /// depend on the start. Correspondences are trilinear (lineariseTrilinear), so the objective is
 /// continuous in the pose.
 Iterated iterate(const PlaneMap& map, const PointArray& scan, const Eigen::Isometry3d& start,
-                 const PolishSettings& s, PointArray& near) {
+                 const PolishSettings& s, PointArray& near, int threads) {
   Iterated res{start.linear(), start.translation()};
   Eigen::Matrix3d& R = res.R;
   Eigen::Vector3d& t = res.t;
@@ -332,7 +368,8 @@ Iterated iterate(const PlaneMap& map, const PointArray& scan, const Eigen::Isome
       }
       const bool collect = round_it == 0;  // a pass over every scan point, filling `near`
       const Linearisation L =
-          collect ? lineariseTrilinear(map, scan, R, t, s.kernel, all_corners, &near, &near_corners)
+          collect ? lineariseTrilinear(map, scan, R, t, s.kernel, all_corners, &near, &near_corners,
+                                       threads)
                   : lineariseTrilinear(map, near, R, t, s.kernel, near_corners);
       if (L.count < s.min_correspondences) break;
       if (it == 0) rho = radiusOfGyration(near);
@@ -425,7 +462,7 @@ void checkTranslation(const Linearisation& L, const std::vector<Row>& rows,
 }  // namespace
 
 PolishResult polishOnPlanes(const PlaneMap& map, const PointArray& scan, const Pose6& pose,
-                            const PolishSettings& s) {
+                            const PolishSettings& s, int threads) {
   PolishResult res;
   res.pose = pose;
   if (scan.empty() || map.voxels() == 0 || !pose.allFinite()) {
@@ -434,7 +471,7 @@ PolishResult polishOnPlanes(const PlaneMap& map, const PointArray& scan, const P
   }
   const Eigen::Isometry3d T0 = poseToIsometry(pose);
   thread_local PointArray near;  // reused: see iterate()
-  const Iterated end = iterate(map, scan, T0, s, near);
+  const Iterated end = iterate(map, scan, T0, s, near, threads);
   res.iterations = end.iterations;
 
   // The covariance and the weak axes from each point's own voxel's plane (with the trilinear

@@ -302,7 +302,7 @@ void CubeRegistration::refineStage(const ScanPoints& points, const std::vector<P
 
 void CubeRegistration::polishStage(const ScanPoints& points, RegistrationResult& res) const {
   const PolishResult p = polishOnPlanes(reference_->planes, *points.polish, res.pose,
-                                        settings_.polish);
+                                        settings_.polish, settings_.search.threads);
   res.polish_tried = true;
   res.polished = p.applied;
   res.polish_iterations = p.iterations;

@@ -12,6 +12,7 @@
 
 #include <Eigen/Eigenvalues>
 
+#include "cube_scan_matcher/core/parallel.h"
 #include "cube_scan_matcher/core/plane_map.h"
 #include "cube_scan_matcher/core/plane_polish.h"
 #include "cube_scan_matcher/core/pose_covariance.h"
@@ -256,6 +257,52 @@ TEST(PlanePolish, TheJackknifeWidensWhatFewCubesFix) {
   std::printf("x sd: plain clustered %.2f mm, jackknife %.2f mm, capped at 1.5 %.2f mm\n",
               1e3 * std::sqrt(a.covariance(0, 0)), 1e3 * std::sqrt(b.covariance(0, 0)),
               1e3 * std::sqrt(capped_x));
+}
+
+// The lazy plane fits from two threads at once (the polish's parallel lookups): each thread
+// sees exactly the planes one thread alone fits, both racing for the same voxels.
+TEST(Parallel, PlaneMapFitsFromTwoThreadsAreTheSerialOnes) {
+  const PointArray reference = makeScene(false, 2);
+  const PlaneMap serial(reference, 0.25, 6, 0.1), shared(reference, 0.25, 6, 0.1);
+  std::vector<Eigen::Vector3d> queries;
+  for (std::size_t i = 0; i < reference.size(); i += 7) {
+    queries.push_back(reference.point(i).cast<double>() + Eigen::Vector3d(0.05, -0.03, 0.02));
+  }
+  std::vector<std::vector<const LocalPlane*>> seen(2, std::vector<const LocalPlane*>(queries.size()));
+  runOnThreads(2, 2, [&](int job, int) {
+    for (std::size_t k = 0; k < queries.size(); ++k) seen[std::size_t(job)][k] = shared.planeAt(queries[k]);
+  });
+  int planes = 0;
+  for (std::size_t k = 0; k < queries.size(); ++k) {
+    const LocalPlane* expected = serial.planeAt(queries[k]);
+    for (int job = 0; job < 2; ++job) {
+      const LocalPlane* got = seen[std::size_t(job)][k];
+      ASSERT_EQ(got == nullptr, expected == nullptr) << k;
+      if (!got) continue;
+      EXPECT_EQ(got->normal, expected->normal) << k;
+      EXPECT_EQ(got->mean, expected->mean) << k;
+    }
+    planes += expected != nullptr;
+  }
+  EXPECT_GT(planes, int(queries.size()) / 2);
+}
+
+// The polish's pass over every point looks up the planes on two threads; the sums are then
+// taken in the same order, so the result is bit for bit the one-thread result.
+TEST(Parallel, PolishOnTwoThreadsEqualsOne) {
+  const KnownPair one(false), two(false);  // each with its own, not yet fitted, planes
+  ASSERT_GT(one.scan.size(), 4096u);       // several jobs of the parallel lookups
+  Pose6 start = isometryToPose(one.truth);
+  start.head<3>() += Eigen::Vector3d(0.08, -0.05, 0.02);
+  start.tail<3>() += Eigen::Vector3d(0.003, -0.002, 0.01);
+  const PolishResult a = polishOnPlanes(one.map, one.scan, start, PolishSettings{}, 1);
+  const PolishResult b = polishOnPlanes(two.map, two.scan, start, PolishSettings{}, 2);
+  ASSERT_TRUE(a.applied) << a.reason;
+  EXPECT_EQ(a.pose, b.pose);
+  EXPECT_EQ(a.covariance, b.covariance);
+  EXPECT_EQ(a.iterations, b.iterations);
+  EXPECT_EQ(a.correspondences, b.correspondences);
+  EXPECT_LT((poseToIsometry(b.pose).translation() - one.truth.translation()).norm(), 0.002);
 }
 
 TEST(PlanePolish, ACorridorIsFlaggedAlongItsAxisAndNotMovedAlongIt) {

@@ -17,9 +17,9 @@ struct SearchSettings {
   /// wins (ties: lowest k). One GNMM from +-1 m/+-8 deg lands in a wrong local maximum in a
   /// part of the trials, four rarely all do. In [1, 64].
   int starts = 4;
-  /// Threads the starts (and the refine candidates and the grid builds) run on; each thread
-  /// takes the next start not yet run and owns a working copy of every grid (a start's result
-  /// does not depend on the thread). In [1, 64].
+  /// Threads the starts (and the refine candidates, the polish's plane lookups and the grid
+  /// builds) run on; each thread takes the next start not yet run and owns a working copy of
+  /// every grid (a start's result does not depend on the thread). In [1, 64].
   int threads = 2;
   /// Beyond the paper: when the polished result is not confirmed (the polish found too few
   /// planes or left the basin, or flags it degenerate: the wrong poses the search lands on

@@ -6,6 +6,7 @@
 // curved surface).
 #pragma once
 
+#include <atomic>
 #include <cstddef>
 #include <cstdint>
 #include <memory>
@@ -49,7 +50,9 @@ class PlaneMap {
   PlaneMap& operator=(PlaneMap&&) noexcept;
 
   /// The plane of the voxel holding q, or nullptr (no reference point there, too few, not flat).
-  /// Fits and caches it on first use: not safe to call from two threads at once.
+  /// Fits and caches it on first use. Safe to call from several threads at once (each plane is
+  /// fitted once, by the first thread that needs it; the others wait for it), but not while
+  /// rebuild() runs.
   const LocalPlane* planeAt(const Eigen::Vector3d& q) const;
   /// The plane of voxel (ix, iy, iz) in voxelIndex() units (offset by 2^20), or nullptr.
   const LocalPlane* planeOfVoxel(std::int64_t ix, std::int64_t iy, std::int64_t iz) const;
@@ -67,8 +70,11 @@ class PlaneMap {
     Eigen::Vector3d sum = Eigen::Vector3d::Zero();
     Eigen::Matrix3d outer = Eigen::Matrix3d::Zero();  // sum of p p^T
   };
-  enum class Fit : std::uint8_t { Unknown, Plane, None };
-  void fit(std::size_t index, std::int64_t ix, std::int64_t iy, std::int64_t iz) const;
+  enum Fit : std::uint8_t { kUnknown, kFitting, kPlane, kNone };
+  /// Fits voxel `index`'s plane into planes_[index]; kPlane or kNone.
+  std::uint8_t fit(std::size_t index, std::int64_t ix, std::int64_t iy, std::int64_t iz) const;
+  /// Claims voxel `index` and fits it, or waits for the thread that claimed it first.
+  std::uint8_t fitOnce(std::size_t index, std::int64_t ix, std::int64_t iy, std::int64_t iz) const;
 
   double voxel_ = 1.0;
   float inv_ = 1.0f;
@@ -77,7 +83,10 @@ class PlaneMap {
   double max_planarity_ = 0.1;
   std::unique_ptr<detail::KeyIndex> keys_;  // voxel key -> index into stats_
   std::vector<Stats> stats_;
-  mutable std::vector<Fit> fit_;
+  // Per voxel: a Fit state. Written with release once its plane is in planes_, read with
+  // acquire, so a thread that sees kPlane sees the plane.
+  mutable std::unique_ptr<std::atomic<std::uint8_t>[]> fit_;
+  std::size_t fit_capacity_ = 0;
   mutable std::vector<LocalPlane> planes_;
   std::vector<std::uint32_t> voxel_of_;  // scratch of rebuild(): each point's voxel index
 };

@@ -135,9 +135,11 @@ struct PolishResult {
   double translation_weak_ratio = 0.0;
 };
 
-/// Polishes `pose` (scan -> reference, eq. 2) on `map` with the points of `scan`.
+/// Polishes `pose` (scan -> reference, eq. 2) on `map` with the points of `scan`. `threads`
+/// share the passes over every scan point's plane lookups (and the lazy plane fits); the
+/// result is the same for any number.
 PolishResult polishOnPlanes(const PlaneMap& map, const PointArray& scan, const Pose6& pose,
-                            const PolishSettings& settings);
+                            const PolishSettings& settings, int threads = 1);
 
 /// The continuous-time polish of a sweep taken while moving.
 struct SweepPolishResult {
