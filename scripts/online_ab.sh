@@ -4,20 +4,25 @@
 # alternately, ROUNDS rounds, with "big" odometry and without odometry (cv), on one vector path.
 # Writes each run's per-scan CSV and log into OUT_DIR and prints (and writes to
 # OUT_DIR/summary.txt) each side's median and p95 time per scan, the ratios, and whether the two
-# sides' poses and evaluations are identical.
+# sides' poses and evaluations are identical; with both sides' CSVs carrying the stage columns,
+# also the median coarse, refine and polish time per scan.
 #
 # The base's worktree stays for the next comparison; `git worktree prune` after removing it.
 #
 # usage: bash scripts/online_ab.sh BASE SEQUENCE_DIR OUT_DIR [ROUNDS=2] [SIMD=avx2]
+#        bash scripts/online_ab.sh --summarize OUT_DIR [ROUNDS=2]   (the summary of runs made)
 #   e.g. bash scripts/online_ab.sh origin/main ../shared/data/balm_os0_hall_seq_a /tmp/ab
 set -euo pipefail
 cd "$(dirname "$0")/.."
-if [ $# -lt 3 ]; then
-  echo "usage: bash scripts/online_ab.sh BASE SEQUENCE_DIR OUT_DIR [ROUNDS=2] [SIMD=avx2]" >&2
-  exit 2
-fi
-BASE="$1" SEQ="$(cd "$2" && pwd)" OUT="$3" ROUNDS="${4:-2}" SIMD="${5:-avx2}"
+usage="usage: bash scripts/online_ab.sh BASE SEQUENCE_DIR OUT_DIR [ROUNDS=2] [SIMD=avx2] | --summarize OUT_DIR [ROUNDS=2]"
 export PATH=/usr/sbin:/usr/bin:/sbin:/bin:$PATH
+if [ "${1:-}" = --summarize ]; then
+  [ $# -ge 2 ] || { echo "$usage" >&2; exit 2; }
+  OUT="$(cd "$2" && pwd)" ROUNDS="${3:-2}"
+  head -4 "$OUT/summary.txt" > "$OUT/summary.tmp" && mv "$OUT/summary.tmp" "$OUT/summary.txt"
+else
+[ $# -ge 3 ] || { echo "$usage" >&2; exit 2; }
+BASE="$1" SEQ="$(cd "$2" && pwd)" OUT="$3" ROUNDS="${4:-2}" SIMD="${5:-avx2}"
 mkdir -p "$OUT"
 OUT="$(cd "$OUT" && pwd)"
 base_rev="$(git rev-parse --verify "$BASE^{commit}")"
@@ -48,6 +53,7 @@ for round in $(seq 1 "$ROUNDS"); do
     done
   done
 done
+fi
 /usr/bin/python3 - "$OUT" "$ROUNDS" >> "$OUT/summary.txt" <<'EOF'
 import csv, os, statistics, sys
 out, rounds = sys.argv[1], int(sys.argv[2])
@@ -78,5 +84,16 @@ for odometry in ("big", "cv"):
               ms(p95["base"]), ms(p95["new"]),
               statistics.median(p95["new"]) / statistics.median(p95["base"]),
               "identical" if same else "DIFFERENT"))
+    stages = ("coarse_s", "refine_s", "polish_s")
+    if all(st in rows("%s_%s_1" % (side, odometry))[0] for side in ("base", "new") for st in stages):
+        parts = []
+        for st in stages:
+            per_side = {}
+            for side in ("base", "new"):
+                per_side[side] = [quantile([float(r[st]) for r in rows("%s_%s_%d" % (side, odometry, k))
+                                            if float(r["polish_s"] or 0) > 0], 0.5)
+                                  for k in range(1, rounds + 1)]
+            parts.append("%s base %s ms, new %s ms" % (st[:-2], ms(per_side["base"]), ms(per_side["new"])))
+        print("  stages (median over the scans that polished): " + "; ".join(parts))
 EOF
 cat "$OUT/summary.txt"
