@@ -60,7 +60,8 @@ void usage(std::ostream& os) {
         "                        (default cubes,cubes-s2s,gicp,ndt)\n"
         "  --submap K            keyframes merged in cubes-submap (default 3)\n"
         "  --keyframe-distance M, --keyframe-angle DEG   keyframe thresholds of the cube methods\n"
-        "  --no-motion-candidate 0|1  without odometry, also search from no motion (default 1)\n"        "  --reject-degenerate B, --require-polish B, --max-sigma M  the gate's criteria\n"
+        "  --no-motion-candidate 0|1  without odometry, also search from no motion (default 1)\n"
+        "  --reject-degenerate B, --require-polish B, --max-sigma M  the gate's criteria\n"
         "                        (GateSettings; B = 0 or 1, M [m], 0 = off)\n"
 
         "  --voxel L             peers' voxel leaf [m] (default 0.2)\n"
@@ -79,11 +80,13 @@ void usage(std::ostream& os) {
         "                        axis, and the NEES (default: none)\n"
         "  --summary FILE        one line per method appended (default: none)\n"
         "  --label TEXT          run label in the CSVs (default: scene or folder name)\n"
-        "  --check-pct P, --check-deg-m D, --check-still-m S, --check-rejected N\n"
+        "  --check-pct P, --check-deg-m D, --check-still-m S, --check-rejected N,\n"
+        "  --check-accepted-wrong W\n"
         "                        exit 2 unless every cube method's relative error over the\n"
-        "                        longest of 100/50/10 m segments the run has is <= P %% and\n"
-        "                        <= D deg/m, its standing-still drift <= S m and its rejected\n"
-        "                        scans <= N (for CI)\n"
+        "                        longest of 100/50/10 m segments the run has is <= P % and\n"
+        "                        <= D deg/m, its standing-still drift <= S m, its rejected\n"
+        "                        scans <= N and its accepted results beyond 0.10 m / 1 deg of\n"
+        "                        the truth <= W (for CI)\n"
      << algorithmOptionsHelp();
 }
 
@@ -96,6 +99,12 @@ struct Method {
   std::vector<double> times;
   /// Cube methods: each scan's work and its split of the time (online_matcher.h OnlineWork).
   std::vector<OnlineWork> work;
+  /// Cube methods, per scan: the gate's verdict; the registration's result (scan -> newest
+  /// keyframe) and the index of that keyframe's scan (-1: nothing registered), to tell right
+  /// results from wrong ones against the truth whatever the gate said.
+  std::vector<GateReason> verdict;
+  std::vector<Eigen::Isometry3d> result;
+  std::vector<int> result_keyframe;
   int accepted = 0, rejected = 0;
   /// Cube methods: per scan, whether it became a keyframe, and its pose's covariance along the
   /// chain (chain_covariance.h) for each of the benchmark's chain settings.
@@ -144,13 +153,19 @@ Method cubeMethod(const std::string& name, const OnlineMatcherSettings& settings
   for (const ChainCovarianceSettings& c : chain_settings) chains->emplace_back(c);
   m.covariances.resize(chain_settings.size());
   auto anchor = std::make_shared<OdometryAnchor>(anchor_settings);
-  m.step = [matcher, chains, anchor, filter](Method& self, const PointArray& points, double stamp,
-                                             const std::optional<Eigen::Isometry3d>& odom) {
+  auto newest_keyframe = std::make_shared<int>(-1);  // the scan the reference is in the frame of
+  m.step = [matcher, chains, anchor, filter, newest_keyframe](
+               Method& self, const PointArray& points, double stamp,
+               const std::optional<Eigen::Isometry3d>& odom) {
     const auto t0 = std::chrono::steady_clock::now();
     const OnlineStep st = matcher->process(filterPoints(points, filter), stamp, odom);
     self.times.push_back(std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
     self.keyframe.push_back(st.reference_updated);
     self.work.push_back(st.work);
+    self.verdict.push_back(st.reason);
+    self.result.push_back(st.registered ? st.result.transform : Eigen::Isometry3d::Identity());
+    self.result_keyframe.push_back(st.registered ? *newest_keyframe : -1);
+    if (st.reference_updated) *newest_keyframe = int(self.poses.size());
     for (std::size_t i = 0; i < chains->size(); ++i) {
       const StepCovariance c = (*chains)[i].add(st);
       self.covariances[i].push_back(c.pose);
@@ -209,6 +224,62 @@ Method peerMethod(const std::string& name, PeerFn fn, double voxel, bool constan
     self.poses.push_back(rigidPart(pose));
   };
   return m;
+}
+
+/// A registration result within these of the truth is right [m], [deg].
+constexpr double kRightM = 0.10, kRightDeg = 1.0;
+
+/// How far scan k's registration result (scan -> its newest keyframe) is from the truth's
+/// increment, [m] and [deg]; nullopt when the scan was not registered.
+std::optional<std::pair<double, double>> resultError(const Method& m, const Trajectory& truth,
+                                                     std::size_t k) {
+  if (k >= m.result_keyframe.size() || m.result_keyframe[k] < 0) return std::nullopt;
+  const Eigen::Isometry3d true_increment =
+      truth[std::size_t(m.result_keyframe[k])].inverse() * truth[k];
+  const Eigen::Isometry3d e = true_increment.inverse() * m.result[k];
+  return std::make_pair(e.translation().norm(), rad2deg(Eigen::AngleAxisd(e.linear()).angle()));
+}
+
+/// The gate's verdicts against the truth: registered scans accepted or rejected, right or
+/// wrong (kRightM, kRightDeg), and the rejections by reason.
+struct Verdicts {
+  int accepted = 0, accepted_wrong = 0, rejected = 0, rejected_right = 0;
+  std::vector<std::pair<std::string, std::pair<int, int>>> reasons;  // reason: rejected, of them right
+};
+
+Verdicts countVerdicts(const Method& m, const Trajectory& truth) {
+  Verdicts v;
+  for (std::size_t k = 0; k < m.verdict.size(); ++k) {
+    const auto err = resultError(m, truth, k);
+    if (!err) continue;
+    const bool right = err->first <= kRightM && err->second <= kRightDeg;
+    if (m.verdict[k] == GateReason::Accepted) {
+      ++v.accepted;
+      v.accepted_wrong += !right;
+      continue;
+    }
+    ++v.rejected;
+    v.rejected_right += right;
+    const std::string reason = toString(m.verdict[k]);
+    auto it = std::find_if(v.reasons.begin(), v.reasons.end(),
+                           [&](const auto& r) { return r.first == reason; });
+    if (it == v.reasons.end()) it = v.reasons.insert(v.reasons.end(), {reason, {0, 0}});
+    ++it->second.first;
+    it->second.second += right;
+  }
+  return v;
+}
+
+void reportVerdicts(const Method& m, const Verdicts& v) {
+  std::printf("%s verdicts against the truth (right: within %.2f m / %.0f deg of it): %d "
+              "accepted, %d of them wrong; %d rejected, %d of them right",
+              m.name.c_str(), kRightM, kRightDeg, v.accepted, v.accepted_wrong, v.rejected,
+              v.rejected_right);
+  for (const auto& [reason, counts] : v.reasons) {
+    std::printf("%s %s %d (%d right)", &reason == &v.reasons.front().first ? ";" : ",",
+                reason.c_str(), counts.first, counts.second);
+  }
+  std::printf("\n");
 }
 
 /// A cube method's work per scan (online_matcher.h OnlineWork): the counts' means and
@@ -312,7 +383,8 @@ int main(int argc, char** argv) {
   sim::SequenceSettings motion;
   std::uint64_t seed = 1;
   int submap = 3;
-  double check_pct = -1, check_deg_m = -1, check_still_m = -1, check_rejected = -1;
+  double check_pct = -1, check_deg_m = -1, check_still_m = -1, check_rejected = -1,
+         check_accepted_wrong = -1;
   std::vector<std::string> methods = {"cubes", "cubes-s2s", "gicp", "ndt"};
   OnlineMatcherSettings matcher_settings;
   RangeFilterSettings filter;
@@ -374,7 +446,8 @@ int main(int argc, char** argv) {
                        }) ||
           r.option("--check-pct", check_pct) || r.option("--check-deg-m", check_deg_m) ||
           r.option("--check-still-m", check_still_m) ||
-          r.option("--check-rejected", check_rejected))
+          r.option("--check-rejected", check_rejected) ||
+          r.option("--check-accepted-wrong", check_accepted_wrong))
         continue;
       r.unknown();
     }
@@ -480,11 +553,12 @@ int main(int argc, char** argv) {
       table.push_back(std::move(o));
     }
 
-    constexpr int kWorkColumns = 12;  // aligns .. polish_s: blank for the peers
+    constexpr int kCubeColumns = 15;  // aligns .. result_err_deg: blank for the peers
     CsvWriter csv(csv_path,
                   "label,odometry,method,scan,time_s,truth_x,truth_y,truth_z,truth_yaw_deg,x,y,z,"
                   "yaw_deg,aligns,searches,evaluations,deskew_rounds,reference_built,register_s,"
-                  "candidate_s,deskew_s,reference_s,coarse_s,refine_s,polish_s");
+                  "candidate_s,deskew_s,reference_s,coarse_s,refine_s,polish_s,verdict,"
+                  "result_err_m,result_err_deg");
     for (const Method& m : table) {
       for (std::size_t k = 0; k < truth.size(); ++k) {
         const Eigen::Vector3d t = truth[k].translation(), e = m.poses[k].translation();
@@ -495,8 +569,14 @@ int main(int argc, char** argv) {
           csv << w.aligns << w.searches << w.evaluations << w.deskew_rounds
               << int(w.reference_built) << w.register_s << w.candidate_s << w.deskew_s
               << w.reference_s << w.coarse_s << w.refine_s << w.polish_s;
+          csv << (k < m.verdict.size() ? toString(m.verdict[k]) : std::string());
+          if (const auto err = resultError(m, truth, k)) {
+            csv << err->first << err->second;
+          } else {
+            csv << "" << "";
+          }
         } else {
-          for (int i = 0; i < kWorkColumns; ++i) csv << "";
+          for (int i = 0; i < kCubeColumns; ++i) csv << "";
         }
         csv.endRow();
       }
@@ -506,7 +586,8 @@ int main(int argc, char** argv) {
       summary.emplace(summary_path,
                       "label,odometry,method,scans,length_m,accepted,rejected,rpe10_pct,"
                       "rpe10_deg_m,rpe50_pct,rpe50_deg_m,rpe100_pct,rpe100_deg_m,ate_m,"
-                      "still_scans,still_m,still_deg,median_time_s,max_error_m,p95_time_s",
+                      "still_scans,still_m,still_deg,median_time_s,max_error_m,p95_time_s,"
+                      "accepted_wrong,rejected_right",
                       CsvWriter::Mode::Append);
     }
     const StationaryDrift still_truth = stationaryDrift(truth, truth);
@@ -560,6 +641,12 @@ int main(int argc, char** argv) {
         if (std::isfinite(max_error)) *summary << max_error;
         else *summary << "";
         *summary << t_p95;
+        if (!m.derived && !m.verdict.empty()) {
+          const Verdicts v = countVerdicts(m, truth);
+          *summary << v.accepted_wrong << v.rejected_right;
+        } else {
+          *summary << "" << "";
+        }
         summary->endRow();
       }
       if (m.name.rfind("cubes", 0) == 0 && !m.derived) {
@@ -594,10 +681,17 @@ int main(int argc, char** argv) {
                         check_rejected);
           failures.push_back(b);
         }
+        const int accepted_wrong = countVerdicts(m, truth).accepted_wrong;
+        if (check_accepted_wrong >= 0 && accepted_wrong > check_accepted_wrong) {
+          std::snprintf(b, sizeof b, "%s: %d accepted results wrong > %.0f", m.name.c_str(),
+                        accepted_wrong, check_accepted_wrong);
+          failures.push_back(b);
+        }
       }
     }
     for (const Method& m : table) {
       if (!m.derived && !m.work.empty()) reportWork(m);
+      if (!m.derived && !m.verdict.empty()) reportVerdicts(m, countVerdicts(m, truth));
     }
     reportConsistency(table, truth, chain_settings, label, odometry_mode, seed, consistency_path);
     for (const std::string& f : failures) std::fprintf(stderr, "CHECK FAILED %s\n", f.c_str());
