@@ -45,6 +45,7 @@ void validate(const OnlineMatcherSettings& s) {
   requireInRange("keyframe interval [s]", k.interval, 0.0, 1e6);
   requireInRange("submap size [keyframes]", k.submap_size, 1, 20);
   requireInRange("no_odometry_scale", s.no_odometry_scale, 1.0, 10.0);
+  requireInRange("no_motion_dense_points", s.no_motion_dense_points, 0, 1000);
   requireInRange("deskew iterations", s.deskew.iterations, 0, 10);
 }
 
@@ -344,8 +345,33 @@ void OnlineMatcher::registerAndGate(OnlineStep& step, const PointArray& points, 
       }
     }
   }
-  if (step.gate_scale > 1.0) registration_.setSettings(settings_.registration);
   step.reason = gate(step.result, step.guess, scaledGate(step.gate_scale));
+  bool changed = step.gate_scale > 1.0;  // the registration's settings are not the defaults
+  // The no-motion maximum (OnlineMatcherSettings::no_motion_dense_points): with odometry, a
+  // rejected result at the last known pose is searched again from the odometry's guess on the
+  // densely sampled points, where J peaks at the truth.
+  if (step.odometry_guess && step.reason != GateReason::Accepted &&
+      settings_.no_motion_dense_points > 0 && settings_.registration.dense_points == 0 &&
+      step.result.ok() && last_known_) {
+    const Pose6 still = isometryToPose(keyframe.pose.inverse() * last_known_->pose);
+    const double edge = settings_.registration.grid.cube_edge;
+    if (posesWithin(step.result.pose, still, edge / 2.0, deg2rad(2.0))) {
+      RegistrationSettings dense = step.gate_scale > 1.0 ? wide : settings_.registration;
+      dense.dense_points = settings_.no_motion_dense_points;
+      registration_.setSettings(dense);
+      changed = true;
+      start = std::chrono::steady_clock::now();
+      RegistrationResult other = registration_.align(points, step.guess);
+      countAlign(step.work, other);
+      step.work.candidate_s += secondsSince(start);
+      const GateReason verdict = gate(other, step.guess, scaledGate(step.gate_scale));
+      if (verdict == GateReason::Accepted) {
+        step.result = std::move(other);
+        step.reason = verdict;
+      }
+    }
+  }
+  if (changed) registration_.setSettings(settings_.registration);
   if (step.result.ok()) step.correction = correctionFromGuess(step.guess, step.result.pose);
   step.accepted = step.reason == GateReason::Accepted;
   if (step.accepted) step.increment = step.result.transform;

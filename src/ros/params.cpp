@@ -65,6 +65,7 @@ void configToSettings(const ScanMatcherConfig& c, OnlineMatcherSettings& m) {
   m.keyframes.interval = c.keyframe_interval;
   m.keyframes.submap_size = c.submap_keyframes;
   m.constant_velocity = c.constant_velocity;
+  m.no_motion_dense_points = c.no_motion_dense_points;
   m.deskew.enabled = c.deskew;
   m.deskew.iterations = c.deskew_iterations;
 }
@@ -150,6 +151,7 @@ ScanMatcherConfig toConfig(const NodeParams& p) {
   c.keyframe_interval = p.matcher.keyframes.interval;
   c.submap_keyframes = p.matcher.keyframes.submap_size;
   c.constant_velocity = p.matcher.constant_velocity;
+  c.no_motion_dense_points = p.matcher.no_motion_dense_points;
   c.deskew = p.matcher.deskew.enabled;
   c.deskew_iterations = p.matcher.deskew.iterations;
   return c;

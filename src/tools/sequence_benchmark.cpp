@@ -61,6 +61,9 @@ void usage(std::ostream& os) {
         "  --submap K            keyframes merged in cubes-submap (default 3)\n"
         "  --keyframe-distance M, --keyframe-angle DEG   keyframe thresholds of the cube methods\n"
         "  --no-motion-candidate 0|1  without odometry, also search from no motion (default 1)\n"
+        "  --no-motion-dense-points N  with odometry, a rejected result at no motion searched\n"
+        "                        again on the dense points (OnlineMatcherSettings; default 4,\n"
+        "                        0 = off)\n"
         "  --reject-degenerate B, --require-polish B, --max-sigma M  the gate's criteria\n"
         "                        (GateSettings; B = 0 or 1, M [m], 0 = off)\n"
 
@@ -409,6 +412,7 @@ int main(int argc, char** argv) {
                        }) ||
           r.option("--voxel", voxel) ||
           r.option("--no-motion-candidate", matcher_settings.no_motion_candidate) ||
+          r.option("--no-motion-dense-points", matcher_settings.no_motion_dense_points) ||
           r.option("--reject-degenerate", gate.reject_degenerate) ||
           r.option("--require-polish", gate.require_polish) ||
           r.option("--max-sigma", gate.max_sigma_m) || r.option("--csv", csv_path) ||

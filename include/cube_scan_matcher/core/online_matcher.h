@@ -67,6 +67,15 @@ struct OnlineMatcherSettings {
   /// With constant_velocity and no odometry, also search from "no motion" (the last registered
   /// pose) and keep the higher J.
   bool no_motion_candidate = true;
+  /// J over all points peaks where the scan lies on the last scan's own sampling pattern, "no
+  /// motion" (docs/method.md, the no-motion maximum). With odometry, a result there (within
+  /// E/2 and 2 deg of the last known pose) that the gate rejects is searched again from the
+  /// odometry's guess with the coarse stage on the densely sampled points alone
+  /// (RegistrationSettings::dense_points = this), and that result is taken when the gate
+  /// accepts it. Without odometry it is not used: there the no-motion candidate competes
+  /// with the prediction, and measured in the park it turned rejections into wrong accepts.
+  /// 0 = off; in [0, 1000].
+  int no_motion_dense_points = 4;
   /// Without odometry the prediction is uncertain (the robot may start, stop or turn on the
   /// spot): the search's restart bounds and the gate's correction bounds are multiplied by
   /// this (as by OnlineStep::gate_scale, the larger of the two). In [1, 10].
