@@ -514,7 +514,7 @@ def work_table(folder):
     print("Medians over the scans that ran the stage (count in brackets); coarse, refine and "
           "polish inside all align() calls of the step.\n")
     print("| run | odometry | align() calls / full searches per scan (mean) | registration | "
-          "no-motion candidate | keyframe submap, median / p95 | coarse | refine | polish | "
+          "no-motion searches | keyframe submap, median / p95 | coarse | refine | polish | "
           "whole step, median / p95 |")
     print("|---|---|---|---|---|---|---|---|---|---|")
     ms = lambda v: "%.1f ms" % (1e3 * v)  # noqa: E731

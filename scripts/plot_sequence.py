@@ -1,6 +1,7 @@
 #!/usr/bin/env python3
 """Trajectories (x-y) of every method against the truth, one panel per sequence_benchmark CSV,
-and the summary CSV as a markdown table.
+and the summary CSV as a markdown table (with each cube method's accepted results that are
+wrong and rejected ones that are right, beyond / within 0.10 m and 1 deg of the truth).
 
 usage: /usr/bin/python3 scripts/plot_sequence.py OUT.png RUN.csv [RUN.csv ...]
        /usr/bin/python3 scripts/plot_sequence.py --table SUMMARY.csv
@@ -25,14 +26,20 @@ def table(path):
     def p95(r):  # summaries written before the column have none
         return "-" if r.get("p95_time_s") in (None, "") else "%.3f" % float(r["p95_time_s"])
 
-    print("| run | odometry | method | scans | m | accepted / rejected | RPE 10 m | RPE 50 m | "
-          "RPE 100 m | ATE m | standing still m / deg | median s | p95 s |")
-    print("|---|---|---|---|---|---|---|---|---|---|---|---|---|")
+    def judged(r):  # accepted wrong / rejected right: the cube methods, in newer summaries
+        if r.get("accepted_wrong") in (None, ""):
+            return "-"
+        return "%s / %s" % (r["accepted_wrong"], r["rejected_right"])
+
+    print("| run | odometry | method | scans | m | accepted / rejected | accepted wrong / "
+          "rejected right | RPE 10 m | RPE 50 m | RPE 100 m | ATE m | standing still m / deg | "
+          "median s | p95 s |")
+    print("|---|---|---|---|---|---|---|---|---|---|---|---|---|---|")
     with open(path) as fh:
         for r in csv.DictReader(fh):
-            print("| %s | %s | %s | %s | %.0f | %s / %s | %s | %s | %s | %.3f | %s | %.3f | %s |" % (
+            print("| %s | %s | %s | %s | %.0f | %s / %s | %s | %s | %s | %s | %.3f | %s | %.3f | %s |" % (
                 r["label"], r["odometry"], r["method"], r["scans"], float(r["length_m"]),
-                r["accepted"], r["rejected"], cell(r["rpe10_pct"], r["rpe10_deg_m"]),
+                r["accepted"], r["rejected"], judged(r), cell(r["rpe10_pct"], r["rpe10_deg_m"]),
                 cell(r["rpe50_pct"], r["rpe50_deg_m"]), cell(r["rpe100_pct"], r["rpe100_deg_m"]),
                 float(r["ate_m"]),
                 "-" if r["still_scans"] == "0" else "%.3f / %.2f" % (float(r["still_m"]), float(r["still_deg"])),
