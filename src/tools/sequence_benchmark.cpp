@@ -326,7 +326,7 @@ void reportWork(const Method& m) {
     }
   };
   stage("registration", register_s);
-  stage("no-motion candidate", candidate_s);
+  stage("no-motion searches", candidate_s);
   stage("de-skew rounds", deskew_s);
   stage("keyframe submap", reference_s);
   std::printf("  in the align() calls:\n");

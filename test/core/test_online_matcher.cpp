@@ -6,6 +6,8 @@
 #include <cstdio>
 #include <limits>
 #include <random>
+#include <stdexcept>
+#include <string>
 
 #include "cube_scan_matcher/core/online_matcher.h"
 #include "cube_scan_matcher/sim/motion.h"
@@ -483,4 +485,20 @@ TEST(OnlineMatcher, NonFiniteOdometryIsIgnoredAndANonFiniteStartIsRefused) {
   EXPECT_FALSE(s.odometry_guess);
   EXPECT_EQ(s.reason, GateReason::Accepted) << s.message;
   EXPECT_TRUE(finite(s));
+}
+
+TEST(OnlineMatcher, NoMotionDensePointsOutOfRangeIsRefusedByName) {
+  for (const int n : {-1, 1001}) {
+    OnlineMatcherSettings s;
+    s.no_motion_dense_points = n;
+    try {
+      OnlineMatcher matcher(s);
+      ADD_FAILURE() << n << " accepted";
+    } catch (const std::invalid_argument& e) {
+      EXPECT_NE(std::string(e.what()).find("no_motion_dense_points"), std::string::npos) << e.what();
+    }
+  }
+  OnlineMatcherSettings off;
+  off.no_motion_dense_points = 0;  // off is a valid setting
+  EXPECT_NO_THROW(OnlineMatcher{off});
 }

@@ -96,7 +96,9 @@ struct OnlineWork {
   int deskew_rounds = 0;        ///< de-skew rounds run (kept or not).
   bool reference_built = false;  ///< the submap's grids were rebuilt (a new keyframe).
   double register_s = 0.0;   ///< [s] the scan's registration from the guess.
-  double candidate_s = 0.0;  ///< [s] the no-motion candidate's (no odometry).
+  /// [s] The no-motion candidate's (no odometry) and the second search on the dense points of
+  /// a rejected result at no motion (with odometry: no_motion_dense_points).
+  double candidate_s = 0.0;
   double deskew_s = 0.0;     ///< [s] the de-skew rounds (sweep polish, re-placing, registration).
   double reference_s = 0.0;  ///< [s] the submap and its grids for a new keyframe.
   double total_s = 0.0;      ///< [s] the whole process() call.
