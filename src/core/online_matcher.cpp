@@ -333,7 +333,7 @@ void OnlineMatcher::registerAndGate(OnlineStep& step, const PointArray& points, 
       last_known_) {
     // Constant velocity fails where the motion changes most (a turn on the spot that starts,
     // stops or reverses): the no-motion guess is searched too, and the higher J wins.
-    const Pose6 still = isometryToPose(keyframe.pose.inverse() * last_known_->pose);
+    const Pose6 still = stillPose(keyframe);
     if ((still - step.guess).norm() > 1e-6) {
       start = std::chrono::steady_clock::now();
       RegistrationResult other = registration_.align(points, still);
@@ -346,35 +346,44 @@ void OnlineMatcher::registerAndGate(OnlineStep& step, const PointArray& points, 
     }
   }
   step.reason = gate(step.result, step.guess, scaledGate(step.gate_scale));
-  bool changed = step.gate_scale > 1.0;  // the registration's settings are not the defaults
-  // The no-motion maximum (OnlineMatcherSettings::no_motion_dense_points): with odometry, a
-  // rejected result at the last known pose is searched again from the odometry's guess on the
-  // densely sampled points, where J peaks at the truth.
-  if (step.odometry_guess && step.reason != GateReason::Accepted &&
-      settings_.no_motion_dense_points > 0 && settings_.registration.dense_points == 0 &&
-      step.result.ok() && last_known_) {
-    const Pose6 still = isometryToPose(keyframe.pose.inverse() * last_known_->pose);
-    const double edge = settings_.registration.grid.cube_edge;
-    if (posesWithin(step.result.pose, still, edge / 2.0, deg2rad(2.0))) {
-      RegistrationSettings dense = step.gate_scale > 1.0 ? wide : settings_.registration;
-      dense.dense_points = settings_.no_motion_dense_points;
-      registration_.setSettings(dense);
-      changed = true;
-      start = std::chrono::steady_clock::now();
-      RegistrationResult other = registration_.align(points, step.guess);
-      countAlign(step.work, other);
-      step.work.candidate_s += secondsSince(start);
-      const GateReason verdict = gate(other, step.guess, scaledGate(step.gate_scale));
-      if (verdict == GateReason::Accepted) {
-        step.result = std::move(other);
-        step.reason = verdict;
-      }
-    }
-  }
-  if (changed) registration_.setSettings(settings_.registration);
+  const bool dense_searched =
+      searchDenseAtNoMotion(step, points, keyframe, step.gate_scale > 1.0 ? wide : settings_.registration);
+  if (step.gate_scale > 1.0 || dense_searched) registration_.setSettings(settings_.registration);
   if (step.result.ok()) step.correction = correctionFromGuess(step.guess, step.result.pose);
   step.accepted = step.reason == GateReason::Accepted;
   if (step.accepted) step.increment = step.result.transform;
+}
+
+Pose6 OnlineMatcher::stillPose(const Keyframe& keyframe) const {
+  return isometryToPose(keyframe.pose.inverse() * last_known_->pose);
+}
+
+bool OnlineMatcher::searchDenseAtNoMotion(OnlineStep& step, const PointArray& points,
+                                          const Keyframe& keyframe,
+                                          const RegistrationSettings& searched) {
+  // J over all points peaks at no motion (the scan on the last scan's own sampling pattern);
+  // on the densely sampled points it peaks at the truth. The gate rejects most such results
+  // (weakly fixed along the path); the odometry's guess says where to search again.
+  if (!step.odometry_guess || step.reason == GateReason::Accepted ||
+      settings_.no_motion_dense_points == 0 || searched.dense_points > 0 || !step.result.ok() ||
+      !last_known_) {
+    return false;
+  }
+  const double edge = searched.grid.cube_edge;
+  if (!posesWithin(step.result.pose, stillPose(keyframe), edge / 2.0, deg2rad(2.0))) return false;
+  RegistrationSettings dense = searched;
+  dense.dense_points = settings_.no_motion_dense_points;
+  registration_.setSettings(dense);
+  const auto start = std::chrono::steady_clock::now();
+  RegistrationResult other = registration_.align(points, step.guess);
+  countAlign(step.work, other);
+  step.work.candidate_s += secondsSince(start);
+  const GateReason verdict = gate(other, step.guess, scaledGate(step.gate_scale));
+  if (verdict == GateReason::Accepted) {
+    step.result = std::move(other);
+    step.reason = verdict;
+  }
+  return true;
 }
 
 bool OnlineMatcher::placeScan(OnlineStep& step, const Keyframe* keyframe,

@@ -224,6 +224,14 @@ class OnlineMatcher {
   /// the gate widened by the scan periods the guess spans, and gates the result.
   void registerAndGate(OnlineStep& step, const PointArray& points, double stamp,
                        double predicted_from, const Keyframe& keyframe);
+  /// "No motion": the last known pose, scan -> `keyframe` [m, rad]. Needs last_known_.
+  Pose6 stillPose(const Keyframe& keyframe) const;
+  /// With odometry, a rejected result at no motion searched again on the dense points
+  /// (OnlineMatcherSettings::no_motion_dense_points) with `searched`, the settings of the first
+  /// search; the result replaces step.result when the gate accepts it. True when it ran (the
+  /// registration's settings are then not the defaults).
+  bool searchDenseAtNoMotion(OnlineStep& step, const PointArray& points, const Keyframe& keyframe,
+                             const RegistrationSettings& searched);
   /// Sets step.pose; false when the chain guard refused the step (not a finite rigid motion).
   bool placeScan(OnlineStep& step, const Keyframe* keyframe, const Eigen::Isometry3d& predicted);
   /// `keyframe`: the reference's frame (null for the first scan of a chain).
