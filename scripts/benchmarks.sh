@@ -186,8 +186,9 @@ scenes() {
 
 # Drift over sequences: OnlineMatcher over 500 m (quick: 100 m) of each paper scene type with
 # "big" odometry errors, against PCL GICP and Open3D's ICPs (quick: the cube method alone);
-# the same without odometry (constant velocity: the "no motion" lock); and every real
-# sequence (a folder with poses.tum) with "big" odometry, the cube method and every peer.
+# the same without odometry (the planar grid and constant velocity); and every real sequence
+# (a folder with poses.tum) with "big" odometry, the cube method and every peer, and without
+# odometry, the cube method.
 # --summary appends, so each run has its own (the section's folder starts empty).
 sequences() {
   fresh_section sequences
@@ -215,6 +216,8 @@ sequences() {
     name="$(basename "$d")"
     step sequences "real_$name" "$Q" --dir "$d" --odometry big --methods "$real_methods" \
       --csv "$out/real_$name.csv" --summary "$out/real_${name}_summary.csv"
+    step sequences "real_cv_$name" "$Q" --dir "$d" --odometry cv --methods cubes \
+      --csv "$out/real_cv_$name.csv" --summary "$out/real_cv_${name}_summary.csv"
   done
 }
 

@@ -18,11 +18,12 @@ void validate(const SearchSettings& s) {
   requireInRange("search axis_probe_gain", s.axis_probe_gain, 0.0, 1.0);
   requireInRange("search ambiguous_weak_ratio", s.ambiguous_weak_ratio, 0.0, 1.0);
   requireInRange("search ambiguous_max_agreeing", s.ambiguous_max_agreeing, 0, 64);
+  validate(s.grid);
 }
 
 CoarseSearchResult coarseSearch(const std::vector<CoincidenceObjective*>& objectives,
                                 const GnmmSettings& gnmm, const SearchSettings& search,
-                                const Pose6& guess) {
+                                const Pose6& guess, const std::vector<Pose6>& seeds) {
   if (int(objectives.size()) < std::min(search.threads, search.starts)) {
     throw std::invalid_argument("coarseSearch: fewer objectives than threads");
   }
@@ -31,8 +32,10 @@ CoarseSearchResult coarseSearch(const std::vector<CoincidenceObjective*>& object
     CoincidenceObjective& f = *objectives[std::size_t(t)];
     GnmmSettings gs = gnmm;
     gs.seed += std::uint64_t(k);
+    const std::size_t seed = std::size_t(k) - 1;
+    const Pose6& from = k >= 1 && seed < seeds.size() ? seeds[seed] : guess;
     runs[std::size_t(k)] =
-        Gnmm(gs).maximize([&f](const Vector6d& p) { return double(f(p)); }, guess);
+        Gnmm(gs).maximize([&f](const Vector6d& p) { return double(f(p)); }, from);
   });
 
   CoarseSearchResult res;

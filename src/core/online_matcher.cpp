@@ -30,6 +30,14 @@ void countAlign(OnlineWork& work, const RegistrationResult& r) {
   work.polish_s += r.time_polish_s;
 }
 
+/// The correction from `guess` to `result` in units of the gate's correction bounds: the larger
+/// of its translation over max_correction_m and its rotation angle over max_correction_rad.
+double correctionSize(const Pose6& guess, const Pose6& result, const GateSettings& gate) {
+  const Eigen::Isometry3d c = poseToIsometry(guess).inverse() * poseToIsometry(result);
+  return std::max(c.translation().norm() / gate.max_correction_m,
+                  Eigen::AngleAxisd(c.linear()).angle() / gate.max_correction_rad);
+}
+
 }  // namespace
 
 void validate(const OnlineMatcherSettings& s) {
@@ -46,6 +54,11 @@ void validate(const OnlineMatcherSettings& s) {
   requireInRange("submap size [keyframes]", k.submap_size, 1, 20);
   requireInRange("no_odometry_scale", s.no_odometry_scale, 1.0, 10.0);
   requireInRange("no_motion_dense_points", s.no_motion_dense_points, 0, 1000);
+  requireInRange("no_odometry_dense_points", s.no_odometry_dense_points, 0, 1000);
+  // The grid as wide as the rejections can make it (registerAndGate) must be valid too.
+  PlanarGridSettings widest = s.no_odometry_grid;
+  widest.half_yaw = widest.half_yaw > 0.0 ? double(EIGEN_PI) : 0.0;
+  validate(widest);
   requireInRange("deskew iterations", s.deskew.iterations, 0, 10);
 }
 
@@ -321,16 +334,38 @@ void OnlineMatcher::registerAndGate(OnlineStep& step, const PointArray& points, 
   step.registered = true;
   step.gate_scale = gateScale(stamp, predicted_from);
   if (!step.odometry_guess) step.gate_scale = std::max(step.gate_scale, settings_.no_odometry_scale);
-  // The guess spans several increments, or has no odometry: search as much wider as the gate is.
+  const bool grid = !step.odometry_guess && settings_.no_odometry_grid.enabled() && last_known_;
+  // The guess spans several increments, or has no odometry: search as much wider as the gate
+  // is (without odometry, with the planar grid instead when it is on).
   RegistrationSettings wide = settings_.registration;
-  wide.gnmm.bounds *= step.gate_scale;
-  if (step.gate_scale > 1.0) registration_.setSettings(wide);
+  if (grid) {
+    // A turn on the spot goes on while its scans are rejected: each one widens the yaw range.
+    wide.search.grid = settings_.no_odometry_grid;
+    wide.search.grid.half_yaw = std::min(double(EIGEN_PI), wide.search.grid.half_yaw *
+                                                               (1.0 + consecutive_rejections_));
+    wide.dense_points = settings_.no_odometry_dense_points;
+    wide.dense_refine = true;
+  } else {
+    wide.gnmm.bounds *= step.gate_scale;
+  }
+  const bool widened = step.gate_scale > 1.0 || grid;
+  if (widened) registration_.setSettings(wide);
   auto start = std::chrono::steady_clock::now();
-  step.result = registration_.align(points, step.guess);
+  step.result = grid ? registration_.align(points, step.guess, stillPose(keyframe))
+                     : registration_.align(points, step.guess);
   countAlign(step.work, step.result);
   step.work.register_s = secondsSince(start);
-  if (!step.odometry_guess && settings_.constant_velocity && settings_.no_motion_candidate &&
-      last_known_) {
+  if (grid && step.result.ok()) {
+    // The grid searched around "no motion" as well as around the prediction: the correction
+    // is measured from the nearer of the two.
+    const Pose6 still = stillPose(keyframe);
+    if (correctionSize(still, step.result.pose, settings_.gate) <
+        correctionSize(step.guess, step.result.pose, settings_.gate)) {
+      step.guess = still;
+    }
+  }
+  if (!grid && !step.odometry_guess && settings_.constant_velocity &&
+      settings_.no_motion_candidate && last_known_) {
     // Constant velocity fails where the motion changes most (a turn on the spot that starts,
     // stops or reverses): the no-motion guess is searched too, and the higher J wins.
     const Pose6 still = stillPose(keyframe);
@@ -345,10 +380,16 @@ void OnlineMatcher::registerAndGate(OnlineStep& step, const PointArray& points, 
       }
     }
   }
-  step.reason = gate(step.result, step.guess, scaledGate(step.gate_scale));
+  GateSettings gate_settings = scaledGate(step.gate_scale);
+  if (grid) {
+    // The grid searched this far around "no motion": a result within it is no large correction.
+    gate_settings.max_correction_rad = std::max(gate_settings.max_correction_rad,
+                                                wide.search.grid.half_yaw + wide.search.grid.step_yaw);
+  }
+  step.reason = gate(step.result, step.guess, gate_settings);
   const bool dense_searched =
-      searchDenseAtNoMotion(step, points, keyframe, step.gate_scale > 1.0 ? wide : settings_.registration);
-  if (step.gate_scale > 1.0 || dense_searched) registration_.setSettings(settings_.registration);
+      searchDenseAtNoMotion(step, points, keyframe, widened ? wide : settings_.registration);
+  if (widened || dense_searched) registration_.setSettings(settings_.registration);
   if (step.result.ok()) step.correction = correctionFromGuess(step.guess, step.result.pose);
   step.accepted = step.reason == GateReason::Accepted;
   if (step.accepted) step.increment = step.result.transform;

@@ -89,10 +89,11 @@ struct CubeRegistration::ScanPoints {
   ScanPoints& operator=(const ScanPoints&) = delete;
   const PointArray* coarse = nullptr;  ///< the coarse search's points (dense part, collapsed)
   const PointArray* full = nullptr;    ///< all points collapsed as for the coarse search: J
-  const PointArray* fine = nullptr;    ///< the refine's points (all points, collapsed)
+  const PointArray* fine = nullptr;    ///< all points collapsed for the refine
   const PointArray* polish = nullptr;  ///< the polish's points (all points, collapsed)
-  PointArray dense_storage, coarse_storage, full_storage, fine_storage, polish_storage,
-      thinned_storage;
+  const PointArray* refine = nullptr;  ///< the refine's points (fine, or its dense part)
+  PointArray dense_storage, coarse_storage, full_storage, fine_storage, refine_storage,
+      polish_storage, thinned_storage;
 };
 
 CubeRegistration::CubeRegistration(const RegistrationSettings& settings)
@@ -198,6 +199,8 @@ void CubeRegistration::prepareScan(const PointArray& scan, ScanPoints& p) const 
                                          : collapsed(from(dense, cf), cf, edge, p.coarse_storage);
   p.full = &dense == &scan ? p.coarse
                            : collapsed(from(scan, cf), cf, edge, p.full_storage);
+  p.refine = p.fine;
+  if (settings_.dense_refine && &dense != &scan) p.refine = collapsed(dense, rf, edge, p.refine_storage);
   const std::size_t cap = std::size_t(settings_.coarse_max_points);
   if (cap > 0 && p.coarse->size() > cap) {
     // Evenly spaced in scan order: the sweep's lines keep their spread.
@@ -256,7 +259,24 @@ int CubeRegistration::score(const PointArray& scan, const Pose6& pose) const {
   return j;
 }
 
-void CubeRegistration::coarseStage(const ScanPoints& points, const Pose6& guess, int attempt,
+std::vector<Pose6> CubeRegistration::gridStage(const ScanPoints& points, const Pose6& centre,
+                                               RegistrationResult& res) const {
+  const SearchSettings& ss = settings_.search;
+  if (!ss.grid.enabled() || ss.starts < 2) return {};
+  const auto start = Clock::now();
+  std::vector<CoincidenceObjective*> objectives;
+  for (auto& w : workspaces_) {
+    w->coarse.setScan(*points.coarse);
+    objectives.push_back(&w->coarse);
+  }
+  PlanarGridResult g = planarGridMaxima(objectives, ss.grid, centre, ss.starts - 1, ss.threads);
+  res.evaluations_grid = g.evaluations;
+  res.time_coarse_s += seconds(start, Clock::now());
+  return std::move(g.maxima);
+}
+
+void CubeRegistration::coarseStage(const ScanPoints& points, const Pose6& guess,
+                                   const std::vector<Pose6>& seeds, int attempt,
                                    RegistrationResult& res, std::vector<Pose6>& ranked,
                                    std::vector<int>& ranked_J) const {
   std::vector<CoincidenceObjective*> objectives;
@@ -266,7 +286,7 @@ void CubeRegistration::coarseStage(const ScanPoints& points, const Pose6& guess,
   }
   GnmmSettings gnmm = settings_.gnmm;
   gnmm.seed += std::uint64_t(attempt) * std::uint64_t(settings_.search.starts);
-  const CoarseSearchResult c = coarseSearch(objectives, gnmm, settings_.search, guess);
+  const CoarseSearchResult c = coarseSearch(objectives, gnmm, settings_.search, guess, seeds);
   res.pose = c.runs.front().best;
   res.J = res.J_coarse = int(c.runs.front().best_value);
   res.J_guess = c.J_guess;
@@ -284,7 +304,7 @@ void CubeRegistration::coarseStage(const ScanPoints& points, const Pose6& guess,
 void CubeRegistration::refineStage(const ScanPoints& points, const std::vector<Pose6>& ranked,
                                    RegistrationResult& res) const {
   const RefineSettings& rs = settings_.refine;
-  const Eigen::Vector3d pivot = centroid(*points.fine);
+  const Eigen::Vector3d pivot = centroid(*points.refine);
   std::vector<MultiScaleObjective> objectives;
   for (auto& w : workspaces_) {
     std::vector<CoincidenceObjective*> fine;
@@ -292,7 +312,7 @@ void CubeRegistration::refineStage(const ScanPoints& points, const std::vector<P
     objectives.emplace_back(std::move(fine), &w->coarse, rs.coarse_weight, pivot);
   }
   // The refine's coarse term evaluates the refine's points on the E grid.
-  for (auto& w : workspaces_) w->setScan(*points.fine, *points.fine);
+  for (auto& w : workspaces_) w->setScan(*points.refine, *points.refine);
   const RefineResult r = refineCandidates(objectives, distinctCandidates(ranked, rs), rs.compass,
                                           settings_.search.threads);
   res.pose = r.pose;
@@ -320,13 +340,14 @@ void CubeRegistration::polishStage(const ScanPoints& points, RegistrationResult&
   res.translation_weak_ratio = p.translation_weak_ratio;
 }
 
-void CubeRegistration::searchAttempt(const ScanPoints& points, const Pose6& guess, int attempt,
+void CubeRegistration::searchAttempt(const ScanPoints& points, const Pose6& guess,
+                                     const std::vector<Pose6>& seeds, int attempt,
                                      RegistrationResult& res, std::vector<Pose6>& ranked,
                                      std::vector<int>& ranked_J) const {
   const RefineSettings& rs = settings_.refine;
   // Coarse search: GNMM starts on the E grid.
   const auto coarse_start = Clock::now();
-  coarseStage(points, guess, attempt, res, ranked, ranked_J);
+  coarseStage(points, guess, seeds, attempt, res, ranked, ranked_J);
   const auto coarse_end = Clock::now();
   res.time_coarse_s = seconds(coarse_start, coarse_end);
 
@@ -395,6 +416,11 @@ void CubeRegistration::axisProbeStage(const ScanPoints& points, RegistrationResu
 }
 
 RegistrationResult CubeRegistration::align(const PointArray& scan, const Pose6& guess) const {
+  return align(scan, guess, guess);
+}
+
+RegistrationResult CubeRegistration::align(const PointArray& scan, const Pose6& guess,
+                                           const Pose6& grid_centre) const {
   const auto start = Clock::now();
   RegistrationResult res;
   res.points_in = scan.size();
@@ -412,7 +438,7 @@ RegistrationResult CubeRegistration::align(const PointArray& scan, const Pose6& 
   if (!reference_) return finish(RegistrationStatus::NoReference, "no reference scan set");
   res.reference_cubes = reference_->coarse.occupiedCount();
   if (scan.empty()) return finish(RegistrationStatus::EmptyScan, "scan has no valid point");
-  if (!guess.allFinite()) {
+  if (!guess.allFinite() || !grid_centre.allFinite()) {
     return finish(RegistrationStatus::InvalidGuess, "initial guess has a NaN or infinite value");
   }
 
@@ -428,16 +454,17 @@ RegistrationResult CubeRegistration::align(const PointArray& scan, const Pose6& 
 
   // 2-5. Coarse search, refine, polish, agreement; again from new seeds while the result is not
   // confirmed (SearchSettings::retries).
+  const std::vector<Pose6> seeds = gridStage(points, grid_centre, res);
   const RegistrationResult before = res;
-  double time_coarse = 0.0, time_refine = 0.0, time_polish = 0.0;
-  int evaluations = 0, iterations = 0, restarts = 0, attempts = 0;
+  double time_coarse = before.time_coarse_s, time_refine = 0.0, time_polish = 0.0;
+  int evaluations = before.evaluations_grid, iterations = 0, restarts = 0, attempts = 0;
   bool done = false;                          // a confirmed result was taken
   std::optional<RegistrationResult> candidate;  // the best ambiguous result so far
   for (int attempt = 0; attempt <= ss.retries; ++attempt) {
     RegistrationResult r = before;
     std::vector<Pose6> r_ranked;
     std::vector<int> r_ranked_J;
-    searchAttempt(points, guess, attempt, r, r_ranked, r_ranked_J);
+    searchAttempt(points, guess, seeds, attempt, r, r_ranked, r_ranked_J);
     ++attempts;
     time_coarse += r.time_coarse_s, time_refine += r.time_refine_s, time_polish += r.time_polish_s;
     evaluations += r.evaluations, iterations += r.iterations, restarts += r.restarts;

@@ -65,6 +65,8 @@ void configToSettings(const ScanMatcherConfig& c, OnlineMatcherSettings& m) {
   m.keyframes.interval = c.keyframe_interval;
   m.keyframes.submap_size = c.submap_keyframes;
   m.constant_velocity = c.constant_velocity;
+  m.no_odometry_grid.half_width_m = c.no_odometry_grid_m;
+  m.no_odometry_grid.half_yaw = deg2rad(c.no_odometry_grid_yaw_deg);
   m.no_motion_dense_points = c.no_motion_dense_points;
   m.deskew.enabled = c.deskew;
   m.deskew.iterations = c.deskew_iterations;
@@ -151,6 +153,8 @@ ScanMatcherConfig toConfig(const NodeParams& p) {
   c.keyframe_interval = p.matcher.keyframes.interval;
   c.submap_keyframes = p.matcher.keyframes.submap_size;
   c.constant_velocity = p.matcher.constant_velocity;
+  c.no_odometry_grid_m = p.matcher.no_odometry_grid.half_width_m;
+  c.no_odometry_grid_yaw_deg = rad2deg(p.matcher.no_odometry_grid.half_yaw);
   c.no_motion_dense_points = p.matcher.no_motion_dense_points;
   c.deskew = p.matcher.deskew.enabled;
   c.deskew_iterations = p.matcher.deskew.iterations;

@@ -64,6 +64,12 @@ void usage(std::ostream& os) {
         "  --no-motion-dense-points N  with odometry, a rejected result at no motion searched\n"
         "                        again on the dense points (OnlineMatcherSettings; default 4,\n"
         "                        0 = off)\n"
+        "  --no-odometry-grid M:DEG  without odometry, the planar grid's half widths around\n"
+        "                        the last pose: x and y [m], yaw [deg] (OnlineMatcherSettings::\n"
+        "                        no_odometry_grid; default 2:45, 0:0 = off: the prediction and\n"
+        "                        the no-motion candidate in widened bounds)\n"
+        "  --no-odometry-dense-points N  without odometry, the coarse and refine stages' dense\n"
+        "                        points (default 4)\n"
         "  --reject-degenerate B, --require-polish B, --max-sigma M  the gate's criteria\n"
         "                        (GateSettings; B = 0 or 1, M [m], 0 = off)\n"
 
@@ -413,6 +419,17 @@ int main(int argc, char** argv) {
           r.option("--voxel", voxel) ||
           r.option("--no-motion-candidate", matcher_settings.no_motion_candidate) ||
           r.option("--no-motion-dense-points", matcher_settings.no_motion_dense_points) ||
+          r.option("--no-odometry-dense-points", matcher_settings.no_odometry_dense_points) ||
+          r.optionWith("--no-odometry-grid",
+                       [&](const std::string& v) {
+                         const std::size_t colon = v.find(':');
+                         if (colon == std::string::npos) {
+                           throw std::invalid_argument("--no-odometry-grid: '" + v + "' is not M:DEG");
+                         }
+                         PlanarGridSettings& g = matcher_settings.no_odometry_grid;
+                         g.half_width_m = io::parseNumber("--no-odometry-grid", v.substr(0, colon));
+                         g.half_yaw = deg2rad(io::parseNumber("--no-odometry-grid", v.substr(colon + 1)));
+                       }) ||
           r.option("--reject-degenerate", gate.reject_degenerate) ||
           r.option("--require-polish", gate.require_polish) ||
           r.option("--max-sigma", gate.max_sigma_m) || r.option("--csv", csv_path) ||

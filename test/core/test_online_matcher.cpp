@@ -63,6 +63,7 @@ TEST(OnlineMatcher, WorkCountsAndTimesEachStage) {
   std::mt19937_64 rng(7);
   OnlineMatcherSettings every_scan;
   every_scan.keyframes.distance = 0.0;  // every accepted scan becomes the keyframe
+  every_scan.no_odometry_grid = PlanarGridSettings{};  // off: the prediction and the candidate
   OnlineMatcher m(every_scan);
   auto stagesWithinTotal = [](const OnlineWork& w) {
     return w.register_s + w.candidate_s + w.deskew_s + w.reference_s <= w.total_s;
@@ -92,8 +93,70 @@ TEST(OnlineMatcher, WorkCountsAndTimesEachStage) {
   s = m.process(scanInBase(scene, robot.pose(), rng), 3.0, std::nullopt);  // no odometry
   EXPECT_EQ(s.work.aligns, 2) << "the prediction and the no-motion candidate";
   EXPECT_GT(s.work.candidate_s, 0.0);
+  EXPECT_EQ(s.result.evaluations_grid, 0);
+  EXPECT_TRUE(stagesWithinTotal(s.work));
+
+  // With the planar grid (the default) one search covers both, seeded by the grid.
+  every_scan.no_odometry_grid = OnlineMatcherSettings{}.no_odometry_grid;
+  m.setSettings(every_scan);
+  robot.advance();
+  s = m.process(scanInBase(scene, robot.pose(), rng), 4.0, std::nullopt);
+  EXPECT_EQ(s.work.aligns, 1);
+  EXPECT_EQ(s.work.candidate_s, 0.0);
+  // At least the grid's poses (more when the scan before was rejected: the yaw widens).
+  EXPECT_GE(s.result.evaluations_grid, every_scan.no_odometry_grid.poses());
+  EXPECT_GT(s.work.evaluations, s.result.evaluations_grid);
   EXPECT_TRUE(stagesWithinTotal(s.work));
 }
+
+// Without odometry, a look-around on the spot (30 deg per scan, out to 90 deg and back) after
+// driving and stopping, as in the sequence benchmark's standing-still runs: every scan is
+// accepted and right with the planar grid (the default), in the hall and the natural world.
+// Without it the searches from the constant-velocity prediction and from "no motion" within
+// +-32 deg miss the turns. (In park world 1 at this spot the turns still lock at "no motion":
+// docs/method.md, "Without odometry: a planar grid search".)
+class LookAround : public ::testing::TestWithParam<sim::SceneType> {};
+
+TEST_P(LookAround, WithoutOdometryIsRegistered) {
+  const sim::Scene scene = sim::Scene::generate(GetParam(), 1);
+  auto run = [&](const OnlineMatcherSettings& settings, bool expect_all_right) {
+    OnlineMatcher m(settings);
+    std::mt19937_64 rng(11);
+    int right = 0, scans = 0;
+    const std::vector<std::pair<double, double>> path = {
+        {10.0, 0.0},  {11.5, 0.0},  {13.0, 0.0},  {13.0, 0.0}, {13.0, 0.0}, {13.0, 30.0},
+        {13.0, 60.0}, {13.0, 90.0}, {13.0, 60.0}, {13.0, 30.0}, {13.0, 0.0}, {14.5, 0.0}};
+    for (const auto& [x, yaw_deg] : path) {
+      Eigen::Isometry3d body = Eigen::Isometry3d::Identity();
+      body.translation() = Eigen::Vector3d(x, 0.0, scene.groundHeight(x, 0.0) + 1.0);
+      body.linear() = rotationFromRpy(0.0, 0.0, deg2rad(yaw_deg));
+      const OnlineStep s = m.process(scanInBase(scene, body, rng), 1.5 * scans, std::nullopt);
+      if (scans++ == 0) continue;
+      // map = the first scan's pose: the chained pose against the truth relative to it.
+      Eigen::Isometry3d first = Eigen::Isometry3d::Identity();
+      first.translation() = Eigen::Vector3d(10.0, 0.0, scene.groundHeight(10.0, 0.0) + 1.0);
+      const Eigen::Isometry3d err = (first.inverse() * body).inverse() * s.pose;
+      const bool ok = s.accepted && err.translation().norm() < 0.05 &&
+                      Eigen::AngleAxisd(err.linear()).angle() < deg2rad(0.5);
+      right += ok;
+      if (expect_all_right) {
+        EXPECT_TRUE(ok) << "x " << x << " m, yaw " << yaw_deg << " deg: " << s.message << ", "
+                        << err.translation().norm() << " m, "
+                        << rad2deg(Eigen::AngleAxisd(err.linear()).angle()) << " deg off";
+      }
+    }
+    return right;
+  };
+  const int scans = 11;
+  EXPECT_EQ(run(OnlineMatcherSettings{}, true), scans);
+  OnlineMatcherSettings off;
+  off.no_odometry_grid = PlanarGridSettings{};
+  EXPECT_LT(run(off, false), scans) << "the look-around without the grid";
+}
+
+INSTANTIATE_TEST_SUITE_P(OnlineMatcher, LookAround,
+                         ::testing::Values(sim::SceneType::Hall, sim::SceneType::Natural),
+                         [](const auto& info) { return sim::toString(info.param); });
 
 TEST(OnlineMatcher, TimeBackwardsResetsAndEmptyOrBadScansKeepTheReference) {
   const sim::Scene scene = sim::Scene::generate(sim::SceneType::Hall, 2);
@@ -501,4 +564,28 @@ TEST(OnlineMatcher, NoMotionDensePointsOutOfRangeIsRefusedByName) {
   OnlineMatcherSettings off;
   off.no_motion_dense_points = 0;  // off is a valid setting
   EXPECT_NO_THROW(OnlineMatcher{off});
+}
+
+// The no-odometry grid is validated as wide as rejections can make its yaw (180 deg): a grid
+// that would then exceed the pose limit is refused when the settings are given, not mid-run.
+TEST(OnlineMatcher, NoOdometryGridAndDensePointsAreValidatedByName) {
+  OnlineMatcherSettings s;
+  s.no_odometry_grid.half_width_m = 12.0;  // 97 x 97 x 31 poses now, x 121 yaw steps at 180 deg
+  try {
+    OnlineMatcher matcher(s);
+    ADD_FAILURE() << "a grid of more than 1e6 poses at its widest accepted";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("planar grid"), std::string::npos) << e.what();
+  }
+  s = OnlineMatcherSettings{};
+  s.no_odometry_dense_points = -1;
+  try {
+    OnlineMatcher matcher(s);
+    ADD_FAILURE() << "-1 accepted";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("no_odometry_dense_points"), std::string::npos) << e.what();
+  }
+  s = OnlineMatcherSettings{};
+  s.no_odometry_grid = PlanarGridSettings{};  // off is a valid setting
+  EXPECT_NO_THROW(OnlineMatcher{s});
 }

@@ -6,6 +6,7 @@
 
 #include "cube_scan_matcher/core/coincidence_objective.h"
 #include "cube_scan_matcher/core/gnmm.h"
+#include "cube_scan_matcher/core/planar_grid.h"
 #include "cube_scan_matcher/core/pose.h"
 
 namespace cube_scan_matcher {
@@ -48,6 +49,11 @@ struct SearchSettings {
   /// rejected by the gate). 0 = off. In [0, 1] and [0, 64].
   double ambiguous_weak_ratio = 0.03;
   int ambiguous_max_agreeing = 1;
+  /// Beyond the paper: before the starts, J on the coarse points over a grid of planar motions
+  /// (planar_grid.h) around the guess (or the centre align() is given); start 0 runs from the
+  /// guess, start k >= 1 from the grid's k-th best local maximum (from the guess when the grid
+  /// has fewer). Off by default (the online matcher turns it on without odometry).
+  PlanarGridSettings grid;
 };
 
 /// Throws std::invalid_argument naming the bad setting.
@@ -63,11 +69,11 @@ struct CoarseSearchResult {
 };
 
 /// Runs search.starts GNMM searches (gnmm settings, seed gnmm.seed + k for start k) from
-/// `guess`, start k on thread k % search.threads with objectives[thread] (each thread's own
-/// working copy of the E grid, bound to the same scan). Needs
-/// objectives.size() >= min(search.threads, search.starts).
+/// `guess` (start k >= 1 from seeds[k - 1] where there is one: the planar grid's maxima), each
+/// taken by the next free thread t with objectives[t] (each thread's own working copy of the E
+/// grid, bound to the same scan). Needs objectives.size() >= min(search.threads, search.starts).
 CoarseSearchResult coarseSearch(const std::vector<CoincidenceObjective*>& objectives,
                                 const GnmmSettings& gnmm, const SearchSettings& search,
-                                const Pose6& guess);
+                                const Pose6& guess, const std::vector<Pose6>& seeds = {});
 
 }  // namespace cube_scan_matcher

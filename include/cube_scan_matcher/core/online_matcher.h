@@ -65,7 +65,8 @@ struct OnlineMatcherSettings {
   /// velocity) instead of from no motion.
   bool constant_velocity = true;
   /// With constant_velocity and no odometry, also search from "no motion" (the last registered
-  /// pose) and keep the higher J.
+  /// pose) and keep the higher J. Not used while no_odometry_grid is on (its grid is centred
+  /// there).
   bool no_motion_candidate = true;
   /// J over all points peaks where the scan lies on the last scan's own sampling pattern, "no
   /// motion" (docs/method.md, the no-motion maximum). With odometry, a result there (within
@@ -77,9 +78,27 @@ struct OnlineMatcherSettings {
   /// 0 = off; in [0, 1000].
   int no_motion_dense_points = 4;
   /// Without odometry the prediction is uncertain (the robot may start, stop or turn on the
-  /// spot): the search's restart bounds and the gate's correction bounds are multiplied by
-  /// this (as by OnlineStep::gate_scale, the larger of the two). In [1, 10].
+  /// spot): the gate's correction bounds, and the search's restart bounds while
+  /// no_odometry_grid is off, are multiplied by this (as by OnlineStep::gate_scale, the larger
+  /// of the two). In [1, 10].
   double no_odometry_scale = 4.0;
+  /// Without odometry, the search covers what a ground robot may have done since the last
+  /// scan (driven on, stopped, turned on the spot; docs/method.md, "Without odometry: a planar
+  /// grid search"): J on the coarse stage's densely sampled points over this planar grid
+  /// around the last known pose (default +-2 m every 0.25 m, +-45 deg every 3 deg) seeds the
+  /// GNMM starts 1.. (SearchSettings::grid), start 0 runs from the prediction within the
+  /// unwidened restart bounds, and the no-motion candidate is not run. The correction is
+  /// measured from the nearer of the prediction and "no motion", and the gate allows a
+  /// rotation as wide as the grid's. After each rejected scan the yaw half width grows by its
+  /// own value again (a turn goes on while its scans are missed), up to 180 deg. Off (both
+  /// half widths 0): the prediction and the no-motion candidate in bounds widened by
+  /// no_odometry_scale.
+  PlanarGridSettings no_odometry_grid{2.0, 0.25, 0.7853981633974483, 0.05235987755982988};
+  /// Without odometry and with no_odometry_grid: the coarse and the refine stages evaluate
+  /// only the points of E-cubes holding at least this many (RegistrationSettings::dense_points
+  /// and dense_refine), where J's maximum at "no motion" and at every submap keyframe's own
+  /// pose is weakest. 0 = all points; in [0, 1000].
+  int no_odometry_dense_points = 4;
   /// After this many consecutive rejected scans the step reports `rejection_alarm`. >= 1.
   int max_consecutive_rejections = 5;
 };

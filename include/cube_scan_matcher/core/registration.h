@@ -52,6 +52,10 @@ struct RegistrationSettings {
   /// to 0.2-0.6 %, but costs accuracy in some pairwise cases (docs/experiments.md, "The
   /// no-motion maximum and dense_points"); the drift benchmarks decide its default.
   int dense_points = 0;
+  /// Beyond the paper: with dense_points, the refine stage evaluates the dense points as well
+  /// (on its finer grids the sparse samples' maximum at "no motion" is sharper still, and it
+  /// recurs wherever a keyframe of a merged submap was taken). Off: the refine uses all points.
+  bool dense_refine = false;
   /// Beyond the paper: the coarse search evaluates at most this many of the collapsed points,
   /// evenly spaced in scan order (J at the result and the gate's J use them all). 0 = all.
   /// In [0, 1e7].
@@ -133,6 +137,9 @@ struct RegistrationResult {
   Eigen::Vector3d translation_weak_axis = Eigen::Vector3d::Zero();
   double translation_weak_ratio = 0.0;
   int evaluations_refine = 0;     ///< of `evaluations`, those of the refine stage.
+  /// Of `evaluations`, those of the planar grid (SearchSettings::grid; 0 when off); its time
+  /// is in time_coarse_s.
+  int evaluations_grid = 0;
   std::string message;            ///< human-readable summary or reason of failure.
 
   bool ok() const { return status == RegistrationStatus::Ok; }
@@ -162,6 +169,10 @@ class CubeRegistration {
   /// Registers `scan` to the reference around `guess` (scan -> reference). Calls on one
   /// instance are serialised (they share the per-thread working copies of the grids).
   RegistrationResult align(const PointArray& scan, const Pose6& guess) const;
+  /// As align(scan, guess), with the planar grid (SearchSettings::grid) around `grid_centre`
+  /// instead of around the guess (without odometry: the last known pose, "no motion").
+  RegistrationResult align(const PointArray& scan, const Pose6& guess,
+                           const Pose6& grid_centre) const;
 
   /// J of `scan` at `pose` on the coarse grid, with the same scan preparation as the result's
   /// J in align() (collapsing, all points). Needs a reference; returns 0 for an empty scan.
@@ -190,9 +201,13 @@ class CubeRegistration {
   void prepareWorkspaces(int count) const;
   /// The steps of align(), under the mutex.
   void prepareScan(const PointArray& scan, ScanPoints& points) const;
-  void coarseStage(const ScanPoints& points, const Pose6& guess, int attempt,
-                   RegistrationResult& res, std::vector<Pose6>& ranked,
-                   std::vector<int>& ranked_J) const;
+  /// The planar grid's best local maxima around `centre` (SearchSettings::grid): the seeds of
+  /// starts 1.. of every attempt.
+  std::vector<Pose6> gridStage(const ScanPoints& points, const Pose6& centre,
+                               RegistrationResult& res) const;
+  void coarseStage(const ScanPoints& points, const Pose6& guess,
+                   const std::vector<Pose6>& seeds, int attempt, RegistrationResult& res,
+                   std::vector<Pose6>& ranked, std::vector<int>& ranked_J) const;
   void refineStage(const ScanPoints& points, const std::vector<Pose6>& ranked,
                    RegistrationResult& res) const;
   void polishStage(const ScanPoints& points, RegistrationResult& res) const;
@@ -203,9 +218,9 @@ class CubeRegistration {
   /// clearly higher J there (SearchSettings::axis_probe_m, axis_probe_gain).
   void axisProbeStage(const ScanPoints& points, RegistrationResult& res) const;
   /// Coarse, refine and polish stages from the seeds of `attempt` (0 = the first).
-  void searchAttempt(const ScanPoints& points, const Pose6& guess, int attempt,
-                     RegistrationResult& res, std::vector<Pose6>& ranked,
-                     std::vector<int>& ranked_J) const;
+  void searchAttempt(const ScanPoints& points, const Pose6& guess,
+                     const std::vector<Pose6>& seeds, int attempt, RegistrationResult& res,
+                     std::vector<Pose6>& ranked, std::vector<int>& ranked_J) const;
   /// Unbinds every objective from this call's points.
   void releaseScan() const;
 
