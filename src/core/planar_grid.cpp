@@ -17,9 +17,9 @@ int halfCount(double half, double step) { return half > 0.0 ? int(std::floor(hal
 
 }  // namespace
 
-int PlanarGridSettings::poses() const {
-  const int nxy = 2 * halfCount(half_width_m, step_m) + 1;
-  const int nyaw = 2 * halfCount(half_yaw, step_yaw) + 1;
+std::int64_t PlanarGridSettings::poses() const {
+  const std::int64_t nxy = 2 * std::int64_t(halfCount(half_width_m, step_m)) + 1;
+  const std::int64_t nyaw = 2 * std::int64_t(halfCount(half_yaw, step_yaw)) + 1;
   return nxy * nxy * nyaw;
 }
 

@@ -100,3 +100,12 @@ TEST(PlanarGrid, OffByDefaultAndSettingsAreValidatedByName) {
   s.grid = grid(2.0, 200);
   EXPECT_THROW(validate(s), std::invalid_argument);
 }
+
+// The finest grid the ranges allow counts its poses without overflow, and is refused.
+TEST(PlanarGrid, TheFinestGridIsCountedAndRefused) {
+  PlanarGridSettings g = grid(20.0, 180.0);
+  g.step_m = 0.05;
+  g.step_yaw = deg2rad(0.1);
+  EXPECT_EQ(g.poses(), std::int64_t(801) * 801 * 3601);
+  EXPECT_THROW(validate(g), std::invalid_argument);
+}

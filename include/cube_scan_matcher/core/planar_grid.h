@@ -5,6 +5,7 @@
 // turn of 30 deg peaks within a few degrees), and the grid finds it in every case.
 #pragma once
 
+#include <cstdint>
 #include <vector>
 
 #include "cube_scan_matcher/core/coincidence_objective.h"
@@ -21,8 +22,8 @@ struct PlanarGridSettings {
   double step_yaw = 0.05235987755982988;  ///< [rad] 3 deg, in [0.1 deg, 45 deg].
 
   bool enabled() const { return half_width_m > 0.0 || half_yaw > 0.0; }
-  /// The number of poses the grid evaluates.
-  int poses() const;
+  /// The number of poses the grid evaluates (64-bit: validate() refuses more than 1e6).
+  std::int64_t poses() const;
 };
 
 /// Throws std::invalid_argument naming the bad setting.
