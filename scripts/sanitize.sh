@@ -3,8 +3,9 @@
 #  1. ASan + UBSan (build-asan): the core, io and conversion gtests, the bad-file corpus through
 #     the tools, and the rostests with the nodelet loaded into a manager that has the ASan
 #     runtime preloaded (and scan_matcher_node, itself instrumented).
-#  2. TSan (build-tsan): the tests whose code runs on several threads (parallel starts, refine
-#     candidates, grid builds, concurrent align(), setReference()/setSettings() during align()).
+#  2. TSan (build-tsan): the tests whose code runs on several threads (parallel starts, the
+#     planar grid, refine candidates, grid builds, concurrent align(), setReference()/setSettings()
+#     during align()).
 # Every sanitizer report goes to a log file; the stage fails unless there is none (and every
 # test passes). Installs what it needs (Debian's GCC ships the sanitizer runtimes).
 #   usage: scripts/sanitize.sh [asan|tsan|all]   (default all)
@@ -104,7 +105,7 @@ if [ "$WHAT" = tsan ] || [ "$WHAT" = all ]; then
   # Its own libraries first (the ASan part may have sourced build-asan's environment).
   export LD_LIBRARY_PATH="$ROOT/build-tsan/devel/lib${LD_LIBRARY_PATH:+:$LD_LIBRARY_PATH}"
   step "test_core threaded tests (TSan)" "$ROOT/build-tsan/devel/lib/cube_scan_matcher/test_core" \
-    --gtest_filter='Registration.*:Parallel.*:CoarseSearch.*:RefineSearch.*:ReferenceGrids.*:GridWorkspace.*:OnlineMatcher.*:ModesAndScenes/SyntheticRegistration.*/default_urban_*'
+    --gtest_filter='Registration.*:Parallel.*:CoarseSearch.*:PlanarGrid.*:RefineSearch.*:ReferenceGrids.*:GridWorkspace.*:OnlineMatcher.*:ModesAndScenes/SyntheticRegistration.*/default_urban_*'
   # The nodelet's threads (the worker, the manager's callbacks, the map -> odom timer,
   # diagnostics) in a manager with the TSan runtime preloaded, while a slow registration runs
   # and services, reconfigure and clouds arrive. Debian's ROS libraries are not instrumented,
