@@ -351,14 +351,14 @@ void OnlineMatcher::registerAndGate(OnlineStep& step, const PointArray& points, 
   const bool widened = step.gate_scale > 1.0 || grid;
   if (widened) registration_.setSettings(wide);
   auto start = std::chrono::steady_clock::now();
-  step.result = grid ? registration_.align(points, step.guess, stillPose(keyframe))
-                     : registration_.align(points, step.guess);
+  const Pose6 grid_centre = grid ? stillPose(keyframe) : step.guess;  // "no motion"
+  step.result = registration_.align(points, step.guess, grid_centre);
   countAlign(step.work, step.result);
   step.work.register_s = secondsSince(start);
   if (grid && step.result.ok()) {
     // The grid searched around "no motion" as well as around the prediction: the correction
     // is measured from the nearer of the two.
-    const Pose6 still = stillPose(keyframe);
+    const Pose6& still = grid_centre;
     if (correctionSize(still, step.result.pose, settings_.gate) <
         correctionSize(step.guess, step.result.pose, settings_.gate)) {
       step.guess = still;

@@ -2,7 +2,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <numeric>
 #include <stdexcept>
 
 #include "cube_scan_matcher/core/parallel.h"
@@ -60,27 +59,24 @@ PlanarGridResult planarGridMaxima(const std::vector<CoincidenceObjective*>& obje
   });
   res.evaluations = int(J.size());
   // Local maxima over the 26-neighbourhood (ties: the earlier grid index wins).
+  auto isPeak = [&](int k, int i, int j) {
+    const std::size_t c = index(k, i, j);
+    if (J[c] <= 0) return false;
+    for (int kk = std::max(k - 1, 0); kk <= std::min(k + 1, sk - 1); ++kk) {
+      for (int ii = std::max(i - 1, 0); ii <= std::min(i + 1, sx - 1); ++ii) {
+        for (int jj = std::max(j - 1, 0); jj <= std::min(j + 1, sx - 1); ++jj) {
+          const std::size_t n = index(kk, ii, jj);
+          if (n != c && (J[n] > J[c] || (J[n] == J[c] && n < c))) return false;
+        }
+      }
+    }
+    return true;
+  };
   std::vector<std::size_t> peaks;
   for (int k = 0; k < sk; ++k) {
     for (int i = 0; i < sx; ++i) {
       for (int j = 0; j < sx; ++j) {
-        const std::size_t c = index(k, i, j);
-        if (J[c] <= 0) continue;
-        bool peak = true;
-        for (int dk = -1; dk <= 1 && peak; ++dk) {
-          for (int di = -1; di <= 1 && peak; ++di) {
-            for (int dj = -1; dj <= 1 && peak; ++dj) {
-              const int kk = k + dk, ii = i + di, jj = j + dj;
-              if ((dk == 0 && di == 0 && dj == 0) || kk < 0 || kk >= sk || ii < 0 || ii >= sx ||
-                  jj < 0 || jj >= sx) {
-                continue;
-              }
-              const std::size_t n = index(kk, ii, jj);
-              peak = J[n] < J[c] || (J[n] == J[c] && n > c);
-            }
-          }
-        }
-        if (peak) peaks.push_back(c);
+        if (isPeak(k, i, j)) peaks.push_back(index(k, i, j));
       }
     }
   }

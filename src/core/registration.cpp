@@ -259,17 +259,23 @@ int CubeRegistration::score(const PointArray& scan, const Pose6& pose) const {
   return j;
 }
 
-std::vector<Pose6> CubeRegistration::gridStage(const ScanPoints& points, const Pose6& centre,
-                                               RegistrationResult& res) const {
-  const SearchSettings& ss = settings_.search;
-  if (!ss.grid.enabled() || ss.starts < 2) return {};
-  const auto start = Clock::now();
+std::vector<CoincidenceObjective*> CubeRegistration::coarseObjectives(
+    const ScanPoints& points) const {
   std::vector<CoincidenceObjective*> objectives;
   for (auto& w : workspaces_) {
     w->coarse.setScan(*points.coarse);
     objectives.push_back(&w->coarse);
   }
-  PlanarGridResult g = planarGridMaxima(objectives, ss.grid, centre, ss.starts - 1, ss.threads);
+  return objectives;
+}
+
+std::vector<Pose6> CubeRegistration::gridStage(const ScanPoints& points, const Pose6& centre,
+                                               RegistrationResult& res) const {
+  const SearchSettings& ss = settings_.search;
+  if (!ss.grid.enabled() || ss.starts < 2) return {};
+  const auto start = Clock::now();
+  PlanarGridResult g =
+      planarGridMaxima(coarseObjectives(points), ss.grid, centre, ss.starts - 1, ss.threads);
   res.evaluations_grid = g.evaluations;
   res.time_coarse_s += seconds(start, Clock::now());
   return std::move(g.maxima);
@@ -279,11 +285,7 @@ void CubeRegistration::coarseStage(const ScanPoints& points, const Pose6& guess,
                                    const std::vector<Pose6>& seeds, int attempt,
                                    RegistrationResult& res, std::vector<Pose6>& ranked,
                                    std::vector<int>& ranked_J) const {
-  std::vector<CoincidenceObjective*> objectives;
-  for (auto& w : workspaces_) {
-    w->coarse.setScan(*points.coarse);
-    objectives.push_back(&w->coarse);
-  }
+  const std::vector<CoincidenceObjective*> objectives = coarseObjectives(points);
   GnmmSettings gnmm = settings_.gnmm;
   gnmm.seed += std::uint64_t(attempt) * std::uint64_t(settings_.search.starts);
   const CoarseSearchResult c = coarseSearch(objectives, gnmm, settings_.search, guess, seeds);

@@ -22,17 +22,23 @@ PlanarGridSettings grid(double half_m, double half_yaw_deg) {
   return g;
 }
 
+/// A corner scene and its scan turned 30 deg on the spot and moved 1 m (`truth`), with two
+/// objectives bound to it (two threads' working copies).
+struct TurnedScan {
+  PointArray ref = cornerScene(6000, 1);
+  CubeGrid cubes = CubeGrid::build(ref, edge(0.5));
+  Pose6 truth = (Pose6() << 1.0, -0.5, 0.0, 0.0, 0.0, deg2rad(30)).finished();
+  PointArray scan = transformed(ref, poseToIsometry(truth).inverse());
+  CoincidenceObjective a{cubes, scan}, b{cubes, scan};
+};
+
 }  // namespace
 
 // A scan turned 30 deg on the spot and moved 1 m: far outside one GNMM's restart bounds
 // (+-8 deg), on the grid: its best maximum is the grid pose nearest the truth.
 TEST(PlanarGrid, BestMaximumIsTheGridPoseNearestTheTruth) {
-  const PointArray ref = cornerScene(6000, 1);
-  const CubeGrid cubes = CubeGrid::build(ref, edge(0.5));
-  Pose6 truth = Pose6::Zero();
-  truth << 1.0, -0.5, 0.0, 0.0, 0.0, deg2rad(30);
-  const PointArray scan = transformed(ref, poseToIsometry(truth).inverse());
-  CoincidenceObjective a(cubes, scan), b(cubes, scan);
+  TurnedScan t;
+  CoincidenceObjective &a = t.a, &b = t.b;
   const PlanarGridSettings g = grid(1.5, 45);
   EXPECT_EQ(g.poses(), 13 * 13 * 31);
   const PlanarGridResult two = planarGridMaxima({&a, &b}, g, Pose6::Zero(), 3, 2);
@@ -55,12 +61,9 @@ TEST(PlanarGrid, BestMaximumIsTheGridPoseNearestTheTruth) {
 // The grid's maxima seed the starts after the first: start 0 from the guess stays where the
 // truth is out of reach, a seeded start finds it.
 TEST(PlanarGrid, SeedsTheCoarseStartsAfterTheFirst) {
-  const PointArray ref = cornerScene(6000, 1);
-  const CubeGrid cubes = CubeGrid::build(ref, edge(0.5));
-  Pose6 truth = Pose6::Zero();
-  truth << 1.0, -0.5, 0.0, 0.0, 0.0, deg2rad(30);
-  const PointArray scan = transformed(ref, poseToIsometry(truth).inverse());
-  CoincidenceObjective a(cubes, scan), b(cubes, scan);
+  TurnedScan t;
+  CoincidenceObjective &a = t.a, &b = t.b;
+  const Pose6& truth = t.truth;
   SearchSettings search;
   search.starts = 2;
   search.grid = grid(1.5, 45);

@@ -201,6 +201,8 @@ class CubeRegistration {
   void prepareWorkspaces(int count) const;
   /// The steps of align(), under the mutex.
   void prepareScan(const PointArray& scan, ScanPoints& points) const;
+  /// Each thread's E-grid objective, bound to the coarse stage's points.
+  std::vector<CoincidenceObjective*> coarseObjectives(const ScanPoints& points) const;
   /// The planar grid's best local maxima around `centre` (SearchSettings::grid): the seeds of
   /// starts 1.. of every attempt.
   std::vector<Pose6> gridStage(const ScanPoints& points, const Pose6& centre,
