@@ -513,7 +513,7 @@ def work_table(folder):
     print("### Where the online step's time goes (the cube method, every scan)\n")
     print("Medians over the scans that ran the stage (count in brackets); coarse, refine and "
           "polish inside all align() calls of the step.\n")
-    print("| run | odometry | align() calls / full searches per scan (mean) | registration | "
+    print("| run | odometry | align() calls / search attempts per scan (mean) | registration | "
           "no-motion searches | keyframe submap, median / p95 | coarse | refine | polish | "
           "whole step, median / p95 |")
     print("|---|---|---|---|---|---|---|---|---|---|")

@@ -25,16 +25,15 @@ void validate(const RefineSettings& s) {
   }
 }
 
-std::vector<Pose6> distinctCandidates(const std::vector<Pose6>& ranked,
-                                      const RefineSettings& s) {
-  auto same = [&s](const Pose6& a, const Pose6& b) {
-    return posesWithin(a, b, s.distinct_translation, s.distinct_rotation);
-  };
-  std::vector<Pose6> kept;
-  for (const Pose6& p : ranked) {
-    if (int(kept.size()) >= s.candidates) break;
-    if (std::none_of(kept.begin(), kept.end(), [&](const Pose6& c) { return same(p, c); })) {
-      kept.push_back(p);
+std::vector<int> distinctIndices(const std::vector<Pose6>& ranked, const RefineSettings& s,
+                                 int count) {
+  std::vector<int> kept;
+  for (int k = 0; k < int(ranked.size()) && int(kept.size()) < count; ++k) {
+    if (std::none_of(kept.begin(), kept.end(), [&](int c) {
+          return posesWithin(ranked[std::size_t(k)], ranked[std::size_t(c)],
+                             s.distinct_translation, s.distinct_rotation);
+        })) {
+      kept.push_back(k);
     }
   }
   return kept;
@@ -60,6 +59,7 @@ RefineResult refineCandidates(std::vector<MultiScaleObjective>& objectives,
     best.evaluations += results[k].evaluations;
     if (results[k].best_value > best.value) {
       best.value = results[k].best_value;
+      best.index = int(k);
       best.pose = objectives[0].pose(results[k].best);
     }
   }

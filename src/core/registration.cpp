@@ -38,6 +38,33 @@ void countAgreement(const std::vector<Pose6>& ranked, const std::vector<int>& ra
   }
 }
 
+// The results in `ranked` that lie apart (kAgreeTranslation, kAgreeRotation) from `tried` and
+// from each other: the one nearest to the prediction `guess` first (in units of the restart
+// box `bounds`), then by decreasing J.
+std::vector<int> untriedByPrediction(const std::vector<Pose6>& ranked, int tried,
+                                     const Pose6& guess, const Vector6d& bounds) {
+  std::vector<int> untried;
+  auto near = [&](int a, int b) {
+    return posesWithin(ranked[std::size_t(a)], ranked[std::size_t(b)], kAgreeTranslation,
+                       kAgreeRotation);
+  };
+  for (int k = 0; k < int(ranked.size()); ++k) {
+    if (!near(k, tried) && std::none_of(untried.begin(), untried.end(),
+                                        [&](int u) { return near(k, u); })) {
+      untried.push_back(k);
+    }
+  }
+  auto distance = [&](int k) {
+    Pose6 d = ranked[std::size_t(k)] - guess;
+    for (int i = 3; i < 6; ++i) d[i] = wrapAngle(d[i]);
+    return d.cwiseAbs().cwiseQuotient(bounds).maxCoeff();
+  };
+  const auto nearest = std::min_element(untried.begin(), untried.end(),
+                                        [&](int a, int b) { return distance(a) < distance(b); });
+  if (nearest != untried.end()) std::rotate(untried.begin(), nearest, nearest + 1);
+  return untried;
+}
+
 using Clock = std::chrono::steady_clock;
 double seconds(Clock::time_point a, Clock::time_point b) {
   return std::chrono::duration<double>(b - a).count();
@@ -303,8 +330,9 @@ void CubeRegistration::coarseStage(const ScanPoints& points, const Pose6& guess,
   }
 }
 
-void CubeRegistration::refineStage(const ScanPoints& points, const std::vector<Pose6>& ranked,
-                                   RegistrationResult& res) const {
+int CubeRegistration::refineStage(const ScanPoints& points,
+                                  const std::vector<Pose6>& candidates,
+                                  RegistrationResult& res) const {
   const RefineSettings& rs = settings_.refine;
   const Eigen::Vector3d pivot = centroid(*points.refine);
   std::vector<MultiScaleObjective> objectives;
@@ -315,11 +343,12 @@ void CubeRegistration::refineStage(const ScanPoints& points, const std::vector<P
   }
   // The refine's coarse term evaluates the refine's points on the E grid.
   for (auto& w : workspaces_) w->setScan(*points.refine, *points.refine);
-  const RefineResult r = refineCandidates(objectives, distinctCandidates(ranked, rs), rs.compass,
-                                          settings_.search.threads);
+  const RefineResult r =
+      refineCandidates(objectives, candidates, rs.compass, settings_.search.threads);
   res.pose = r.pose;
   res.evaluations += r.evaluations;
   res.evaluations_refine = r.evaluations;
+  return r.index;
 }
 
 void CubeRegistration::polishStage(const ScanPoints& points, RegistrationResult& res) const {
@@ -342,20 +371,31 @@ void CubeRegistration::polishStage(const ScanPoints& points, RegistrationResult&
   res.translation_weak_ratio = p.translation_weak_ratio;
 }
 
-void CubeRegistration::searchAttempt(const ScanPoints& points, const Pose6& guess,
-                                     const std::vector<Pose6>& seeds, int attempt,
-                                     RegistrationResult& res, std::vector<Pose6>& ranked,
-                                     std::vector<int>& ranked_J) const {
+int CubeRegistration::searchAttempt(const ScanPoints& points, const Pose6& guess,
+                                    const std::vector<Pose6>& seeds, int attempt, int from,
+                                    RegistrationResult& res, std::vector<Pose6>& ranked,
+                                    std::vector<int>& ranked_J) const {
   const RefineSettings& rs = settings_.refine;
-  // Coarse search: GNMM starts on the E grid.
+  // Coarse search: GNMM starts on the E grid; or an earlier attempt's coarse result.
   const auto coarse_start = Clock::now();
-  coarseStage(points, guess, seeds, attempt, res, ranked, ranked_J);
+  std::vector<int> refined;  // indices in `ranked` of the refine's candidates
+  if (from >= 0) {
+    res.pose = ranked[std::size_t(from)];
+    res.J = res.J_coarse = ranked_J[std::size_t(from)];
+    refined = {from};
+  } else {
+    coarseStage(points, guess, seeds, attempt, res, ranked, ranked_J);
+    refined = distinctIndices(ranked, rs, rs.candidates);
+  }
+  int refined_from = refined.front();
   const auto coarse_end = Clock::now();
   res.time_coarse_s = seconds(coarse_start, coarse_end);
 
   // Refine (not in the paper): compass search on the fine grids from the coarse results.
   if (rs.enabled && res.J > 0 && !reference_->fine.empty()) {
-    refineStage(points, ranked, res);
+    std::vector<Pose6> candidates;
+    for (const int k : refined) candidates.push_back(ranked[std::size_t(k)]);
+    refined_from = refined[std::size_t(refineStage(points, candidates, res))];
     res.time_refine_s = seconds(coarse_end, Clock::now());
   }
 
@@ -378,6 +418,7 @@ void CubeRegistration::searchAttempt(const ScanPoints& points, const Pose6& gues
     axisProbeStage(points, res);
     res.time_polish_s += seconds(probe_start, Clock::now());
   }
+  return refined_from;
 }
 
 CoincidenceObjective& CubeRegistration::resultObjective(const ScanPoints& points) const {
@@ -462,11 +503,34 @@ RegistrationResult CubeRegistration::align(const PointArray& scan, const Pose6& 
   int evaluations = before.evaluations_grid, iterations = 0, restarts = 0, attempts = 0;
   bool done = false;                          // a confirmed result was taken
   std::optional<RegistrationResult> candidate;  // the best ambiguous result so far
-  for (int attempt = 0; attempt <= ss.retries; ++attempt) {
+  // With the planar grid the seeds are the same on every attempt, and a retry's coarse stage
+  // lands on the same maxima. A result that is not confirmed is retried from the next coarse
+  // result of the first attempt apart from those refined alone so far instead (a scan turned on
+  // the spot: the coarse stage ranks the truth below a maximum at a submap keyframe's own
+  // pose); an ambiguous one by a new coarse search (a consensus).
+  std::vector<Pose6> ranked0;
+  std::vector<int> ranked0_J, untried;
+  const bool from_ranked = ss.grid.enabled() && ss.retries > 0;
+  int searches = 0;  // coarse searches run: at most 1 + retries
+  bool previous_ambiguous = false;
+  for (int attempt = 0;; ++attempt) {
     RegistrationResult r = before;
-    std::vector<Pose6> r_ranked;
-    std::vector<int> r_ranked_J;
-    searchAttempt(points, guess, seeds, attempt, r, r_ranked, r_ranked_J);
+    std::vector<Pose6> r_ranked = ranked0;
+    std::vector<int> r_ranked_J = ranked0_J;
+    int from = -1;
+    if (attempt > 0 && from_ranked && !previous_ambiguous && !untried.empty()) {
+      from = untried.front();
+      untried.erase(untried.begin());
+    } else if (attempt > 0 && searches > ss.retries) {
+      break;
+    }
+    if (from < 0) ++searches;
+    const int refined_from =
+        searchAttempt(points, guess, seeds, searches - 1, from, r, r_ranked, r_ranked_J);
+    if (attempt == 0 && from_ranked) {
+      ranked0 = r_ranked, ranked0_J = r_ranked_J;
+      untried = untriedByPrediction(ranked0, refined_from, guess, settings_.gnmm.bounds);
+    }
     ++attempts;
     time_coarse += r.time_coarse_s, time_refine += r.time_refine_s, time_polish += r.time_polish_s;
     evaluations += r.evaluations, iterations += r.iterations, restarts += r.restarts;
@@ -482,6 +546,7 @@ RegistrationResult CubeRegistration::align(const PointArray& scan, const Pose6& 
       res = r, done = true;
       break;
     }
+    previous_ambiguous = ambiguous;
     if (!ambiguous) continue;
     if (candidate &&
         posesWithin(candidate->pose, r.pose, kConsensusTranslation, kConsensusRotation)) {

@@ -319,7 +319,7 @@ void reportWork(const Method& m) {
   auto max = [](const std::vector<double>& v) {
     return v.empty() ? 0.0 : *std::max_element(v.begin(), v.end());
   };
-  std::printf("%s work per scan: align() calls mean %.2f (max %.0f), full searches mean %.2f "
+  std::printf("%s work per scan: align() calls mean %.2f (max %.0f), search attempts mean %.2f "
               "(max %.0f), de-skew rounds mean %.2f (max %.0f)\n",
               m.name.c_str(), mean(aligns), max(aligns), mean(searches), max(searches),
               mean(rounds), max(rounds));

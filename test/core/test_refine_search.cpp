@@ -12,19 +12,14 @@ using namespace cube_scan_matcher::test;
 
 TEST(RefineSearch, DistinctCandidatesSkipPosesCloseToAKeptOne) {
   RefineSettings s;
-  s.candidates = 3;
   Pose6 a = Pose6::Zero(), near_a = a, b = a, c = a, d = a;
   near_a[0] = 0.05;               // within 0.1 m of a
   b[0] = 0.3;                     // 0.3 m away
   c[5] = deg2rad(2.0);            // 2 deg away
   d[1] = -0.5;
-  const std::vector<Pose6> kept = distinctCandidates({a, near_a, b, c, d}, s);
-  ASSERT_EQ(kept.size(), 3u);
-  EXPECT_EQ(kept[0], a);
-  EXPECT_EQ(kept[1], b);
-  EXPECT_EQ(kept[2], c);
-  s.candidates = 1;
-  EXPECT_EQ(distinctCandidates({a, b}, s).size(), 1u);
+  EXPECT_EQ(distinctIndices({a, near_a, b, c, d}, s, 3), (std::vector<int>{0, 2, 3}));
+  EXPECT_EQ(distinctIndices({a, near_a, b, c, d}, s, 10), (std::vector<int>{0, 2, 3, 4}));
+  EXPECT_EQ(distinctIndices({a, b}, s, 1), (std::vector<int>{0}));
 }
 
 TEST(RefineSearch, ClimbsFromEachCandidateAndKeepsTheBest) {

@@ -29,7 +29,11 @@ struct SearchSettings {
   /// the first confirmed result wins (an ambiguous one only once a retry lands on it again:
   /// ambiguous_weak_ratio), else the first one. No retry without the polish (the
   /// paper's mode) or when the first result is confirmed. A scene that is degenerate
-  /// (a tunnel) pays every retry. In [0, 8].
+  /// (a tunnel) pays every retry. With the planar grid (`grid`) the seeds do not change
+  /// between searches: a result that is not confirmed is first refined and polished again
+  /// from each of the first search's other coarse results (those 0.25 m / 2 deg apart from
+  /// the tried ones, the one nearest the guess first), then searched again; an ambiguous one
+  /// is searched again. In [0, 8].
   int retries = 2;
   /// Beyond the paper: after the polish, J on the E grid is probed along the weakest
   /// translation axis of the result (PolishResult::translation_weak_axis, reference frame) at

@@ -110,7 +110,7 @@ void validate(const OnlineMatcherSettings& settings);
 /// beyond a single registration (sequence_benchmark reports it per scan).
 struct OnlineWork {
   int aligns = 0;       ///< Registration::align() calls: the scan, the no-motion candidate, de-skew rounds.
-  int searches = 0;     ///< full searches over those calls (RegistrationResult::attempts: 1 + retries used).
+  int searches = 0;     ///< search attempts over those calls (RegistrationResult::attempts: 1 + retries used).
   int evaluations = 0;  ///< objective evaluations over those calls.
   int deskew_rounds = 0;        ///< de-skew rounds run (kept or not).
   bool reference_built = false;  ///< the submap's grids were rebuilt (a new keyframe).

@@ -40,15 +40,15 @@ struct RefineSettings {
 /// Throws std::invalid_argument naming the bad setting (only when enabled).
 void validate(const RefineSettings& settings);
 
-/// The first settings.candidates poses of `ranked` (best first) that are distinct from every
+/// The indices in `ranked` (best first) of its first `count` poses that are distinct from every
 /// one kept before them (distinct_translation, distinct_rotation).
-std::vector<Pose6> distinctCandidates(const std::vector<Pose6>& ranked,
-                                      const RefineSettings& settings);
-
+std::vector<int> distinctIndices(const std::vector<Pose6>& ranked, const RefineSettings& settings,
+                                 int count);
 struct RefineResult {
   Pose6 pose = Pose6::Zero();  ///< the winner [m, rad] (eq. 2).
   double value = 0.0;          ///< its multi-scale objective.
   int evaluations = 0;         ///< of all candidates.
+  int index = 0;               ///< the winner's index in the candidates.
 };
 
 /// Compass search from each candidate (at least one), on up to `threads` threads, each with

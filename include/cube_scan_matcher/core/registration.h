@@ -98,8 +98,8 @@ struct RegistrationResult {
   /// How far the polish moved the pose from the refine's result [m], [rad] (a diagnostic; 0
   /// when it did not run; PolishResult::shift_m).
   double polish_shift_m = 0.0, polish_shift_rad = 0.0;
-  /// Searches run (1 + the retries that ran: SearchSettings::retries) and the one the result
-  /// comes from (0 = the first).
+  /// Search attempts run (the first, the retries: SearchSettings::retries) and the one the
+  /// result comes from (0 = the first).
   int attempts = 1;
   int attempt_used = 0;
   /// Ambiguity: the coarse starts whose result lies within 0.25 m / 2 deg of the final pose,
@@ -210,8 +210,9 @@ class CubeRegistration {
   void coarseStage(const ScanPoints& points, const Pose6& guess,
                    const std::vector<Pose6>& seeds, int attempt, RegistrationResult& res,
                    std::vector<Pose6>& ranked, std::vector<int>& ranked_J) const;
-  void refineStage(const ScanPoints& points, const std::vector<Pose6>& ranked,
-                   RegistrationResult& res) const;
+  /// Compass search from the candidates; the index of the one the result started from.
+  int refineStage(const ScanPoints& points, const std::vector<Pose6>& candidates,
+                  RegistrationResult& res) const;
   void polishStage(const ScanPoints& points, RegistrationResult& res) const;
   /// The E grid's objective bound to all the scan's points, collapsed as for the coarse stage:
   /// J at a result, before and after the polish and along the axis probe.
@@ -219,10 +220,12 @@ class CubeRegistration {
   /// Probes J along the weakest translation axis of a polished result and moves it to a
   /// clearly higher J there (SearchSettings::axis_probe_m, axis_probe_gain).
   void axisProbeStage(const ScanPoints& points, RegistrationResult& res) const;
-  /// Coarse, refine and polish stages from the seeds of `attempt` (0 = the first).
-  void searchAttempt(const ScanPoints& points, const Pose6& guess,
-                     const std::vector<Pose6>& seeds, int attempt, RegistrationResult& res,
-                     std::vector<Pose6>& ranked, std::vector<int>& ranked_J) const;
+  /// Coarse, refine and polish stages from the seeds of `attempt` (0 = the first) into
+  /// `ranked`/`ranked_J`; with `from` >= 0, no coarse stage: refine and polish from ranked[from]
+  /// alone. Returns the index in `ranked` of the coarse result the refine's winner started from.
+  int searchAttempt(const ScanPoints& points, const Pose6& guess, const std::vector<Pose6>& seeds,
+                    int attempt, int from, RegistrationResult& res, std::vector<Pose6>& ranked,
+                    std::vector<int>& ranked_J) const;
   /// Unbinds every objective from this call's points.
   void releaseScan() const;
 
