@@ -504,10 +504,11 @@ RegistrationResult CubeRegistration::align(const PointArray& scan, const Pose6& 
   bool done = false;                          // a confirmed result was taken
   std::optional<RegistrationResult> candidate;  // the best ambiguous result so far
   // With the planar grid the seeds are the same on every attempt, and a retry's coarse stage
-  // lands on the same maxima. A result that is not confirmed is retried from the next coarse
-  // result of the first attempt apart from those refined alone so far instead (a scan turned on
-  // the spot: the coarse stage ranks the truth below a maximum at a submap keyframe's own
-  // pose); an ambiguous one by a new coarse search (a consensus).
+  // lands on the same maxima. So a result that is not confirmed is retried first from the
+  // first attempt's other coarse results, one at a time (untried: those apart from the ones
+  // tried; a scan turned on the spot, where the coarse stage or the refine ranks the truth
+  // below a submap keyframe's own pose), then by a new coarse search; an ambiguous result by a
+  // new coarse search (a consensus needs an independent search).
   std::vector<Pose6> ranked0;
   std::vector<int> ranked0_J, untried;
   const bool from_ranked = ss.grid.enabled() && ss.retries > 0;
