@@ -32,7 +32,8 @@ CoarseSearchResult coarseSearch(const std::vector<CoincidenceObjective*>& object
     CoincidenceObjective& f = *objectives[std::size_t(t)];
     GnmmSettings gs = gnmm;
     gs.seed += std::uint64_t(k);
-    const Pose6& from = k >= 1 && std::size_t(k - 1) < seeds.size() ? seeds[std::size_t(k - 1)] : guess;
+    const bool seeded = k >= 1 && std::size_t(k - 1) < seeds.size();
+    const Pose6& from = seeded ? seeds[std::size_t(k - 1)] : guess;
     runs[std::size_t(k)] =
         Gnmm(gs).maximize([&f](const Vector6d& p) { return double(f(p)); }, from);
   });

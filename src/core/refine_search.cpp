@@ -25,13 +25,12 @@ void validate(const RefineSettings& s) {
   }
 }
 
-std::vector<int> distinctIndices(const std::vector<Pose6>& ranked, const RefineSettings& s,
-                                 int count) {
-  std::vector<int> kept;
+std::vector<int> distinctIndices(const std::vector<Pose6>& ranked, double translation,
+                                 double rotation, int count, std::vector<int> kept) {
   for (int k = 0; k < int(ranked.size()) && int(kept.size()) < count; ++k) {
     if (std::none_of(kept.begin(), kept.end(), [&](int c) {
-          return posesWithin(ranked[std::size_t(k)], ranked[std::size_t(c)],
-                             s.distinct_translation, s.distinct_rotation);
+          return posesWithin(ranked[std::size_t(k)], ranked[std::size_t(c)], translation,
+                             rotation);
         })) {
       kept.push_back(k);
     }

@@ -43,17 +43,9 @@ void countAgreement(const std::vector<Pose6>& ranked, const std::vector<int>& ra
 // box `bounds`), then by decreasing J.
 std::vector<int> untriedByPrediction(const std::vector<Pose6>& ranked, int tried,
                                      const Pose6& guess, const Vector6d& bounds) {
-  std::vector<int> untried;
-  auto near = [&](int a, int b) {
-    return posesWithin(ranked[std::size_t(a)], ranked[std::size_t(b)], kAgreeTranslation,
-                       kAgreeRotation);
-  };
-  for (int k = 0; k < int(ranked.size()); ++k) {
-    if (!near(k, tried) && std::none_of(untried.begin(), untried.end(),
-                                        [&](int u) { return near(k, u); })) {
-      untried.push_back(k);
-    }
-  }
+  std::vector<int> untried =
+      distinctIndices(ranked, kAgreeTranslation, kAgreeRotation, int(ranked.size()), {tried});
+  untried.erase(untried.begin());  // `tried` itself
   auto distance = [&](int k) {
     Pose6 d = ranked[std::size_t(k)] - guess;
     for (int i = 3; i < 6; ++i) d[i] = wrapAngle(d[i]);
@@ -385,7 +377,8 @@ int CubeRegistration::searchAttempt(const ScanPoints& points, const Pose6& guess
     refined = {from};
   } else {
     coarseStage(points, guess, seeds, attempt, res, ranked, ranked_J);
-    refined = distinctIndices(ranked, rs, rs.candidates);
+    refined = distinctIndices(ranked, rs.distinct_translation, rs.distinct_rotation,
+                              rs.candidates);
   }
   int refined_from = refined.front();
   const auto coarse_end = Clock::now();

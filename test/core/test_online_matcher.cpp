@@ -116,7 +116,6 @@ TEST(OnlineMatcher, WorkCountsAndTimesEachStage) {
 // within +-32 deg miss the turns. In the park the coarse stage's best maximum at the first
 // turn is "no motion": only the retries from the first search's other coarse results
 // (SearchSettings::retries, with the grid) reach the truth there.
-
 class LookAround : public ::testing::TestWithParam<sim::SceneType> {};
 
 TEST_P(LookAround, WithoutOdometryIsRegistered) {

@@ -17,9 +17,12 @@ TEST(RefineSearch, DistinctCandidatesSkipPosesCloseToAKeptOne) {
   b[0] = 0.3;                     // 0.3 m away
   c[5] = deg2rad(2.0);            // 2 deg away
   d[1] = -0.5;
-  EXPECT_EQ(distinctIndices({a, near_a, b, c, d}, s, 3), (std::vector<int>{0, 2, 3}));
-  EXPECT_EQ(distinctIndices({a, near_a, b, c, d}, s, 10), (std::vector<int>{0, 2, 3, 4}));
-  EXPECT_EQ(distinctIndices({a, b}, s, 1), (std::vector<int>{0}));
+  const double t = s.distinct_translation, r = s.distinct_rotation;
+  EXPECT_EQ(distinctIndices({a, near_a, b, c, d}, t, r, 3), (std::vector<int>{0, 2, 3}));
+  EXPECT_EQ(distinctIndices({a, near_a, b, c, d}, t, r, 10), (std::vector<int>{0, 2, 3, 4}));
+  EXPECT_EQ(distinctIndices({a, b}, t, r, 1), (std::vector<int>{0}));
+  // Indices already kept come first and exclude their neighbours.
+  EXPECT_EQ(distinctIndices({a, near_a, b, c, d}, t, r, 10, {2}), (std::vector<int>{2, 0, 3, 4}));
 }
 
 TEST(RefineSearch, ClimbsFromEachCandidateAndKeepsTheBest) {

@@ -40,10 +40,11 @@ struct RefineSettings {
 /// Throws std::invalid_argument naming the bad setting (only when enabled).
 void validate(const RefineSettings& settings);
 
-/// The indices in `ranked` (best first) of its first `count` poses that are distinct from every
-/// one kept before them (distinct_translation, distinct_rotation).
-std::vector<int> distinctIndices(const std::vector<Pose6>& ranked, const RefineSettings& settings,
-                                 int count);
+/// The indices in `ranked` (best first) of its poses that differ from every one kept before
+/// them by more than `translation` [m] or, in some angle, `rotation` [rad], up to `count` in
+/// all; `kept` (indices already kept) is returned first and counts.
+std::vector<int> distinctIndices(const std::vector<Pose6>& ranked, double translation,
+                                 double rotation, int count, std::vector<int> kept = {});
 struct RefineResult {
   Pose6 pose = Pose6::Zero();  ///< the winner [m, rad] (eq. 2).
   double value = 0.0;          ///< its multi-scale objective.
