@@ -23,7 +23,8 @@ void validate(const SearchSettings& s) {
 
 CoarseSearchResult coarseSearch(const std::vector<CoincidenceObjective*>& objectives,
                                 const GnmmSettings& gnmm, const SearchSettings& search,
-                                const Pose6& guess, const std::vector<Pose6>& seeds) {
+                                const Pose6& guess, const std::vector<Pose6>& seeds,
+                                const PointArray* screen) {
   if (int(objectives.size()) < std::min(search.threads, search.starts)) {
     throw std::invalid_argument("coarseSearch: fewer objectives than threads");
   }
@@ -34,8 +35,22 @@ CoarseSearchResult coarseSearch(const std::vector<CoincidenceObjective*>& object
     gs.seed += std::uint64_t(k);
     const bool seeded = k >= 1 && std::size_t(k - 1) < seeds.size();
     const Pose6& from = seeded ? seeds[std::size_t(k - 1)] : guess;
-    runs[std::size_t(k)] =
-        Gnmm(gs).maximize([&f](const Vector6d& p) { return double(f(p)); }, from);
+    if (!screen || gs.screen_iterations <= 0) {
+      runs[std::size_t(k)] =
+          Gnmm(gs).maximize([&f](const Vector6d& p) { return double(f(p)); }, from);
+      return;
+    }
+    const PointArray* all = f.scan();
+    const Objective6 on_screen = [&f, screen](const Vector6d& p) {
+      if (f.scan() != screen) f.setScan(*screen);
+      return double(f(p));
+    };
+    const Objective6 on_all = [&f, all](const Vector6d& p) {
+      if (f.scan() != all) f.setScan(*all);
+      return double(f(p));
+    };
+    runs[std::size_t(k)] = Gnmm(gs).maximize(on_screen, on_all, from);
+    f.setScan(*all);
   });
 
   CoarseSearchResult res;

@@ -17,6 +17,9 @@ void validate(const GnmmSettings& s) {
     fail("max_iterations must be in [1, 1000000], got " + std::to_string(s.max_iterations));
   if (!((s.bounds.array() > 0.0).all() && s.bounds.allFinite()))
     fail("restart bounds must all be finite and > 0");
+  if (s.screen_iterations < 0 || s.screen_iterations > s.max_iterations)
+    fail("screen_iterations must be in [0, max_iterations = " + std::to_string(s.max_iterations) +
+         "], got " + std::to_string(s.screen_iterations));
   if (!(s.reflection > 0.0)) fail("reflection must be > 0");
   if (!(s.expansion > 1.0)) fail("expansion must be > 1");
   if (!(s.contraction > 0.0 && s.contraction < 1.0)) fail("contraction must be in (0, 1)");
@@ -25,14 +28,21 @@ void validate(const GnmmSettings& s) {
 Gnmm::Gnmm(const GnmmSettings& settings) : settings_(settings) { validate(settings_); }
 
 GnmmResult Gnmm::maximize(const Objective6& f, const Vector6d& initial) const {
+  return maximize(f, f, initial);
+}
+
+GnmmResult Gnmm::maximize(const Objective6& screen, const Objective6& full,
+                          const Vector6d& initial) const {
   const GnmmSettings& s = settings_;
+  const bool screening = &screen != &full && s.screen_iterations > 0;
+  const Objective6* f = screening ? &screen : &full;
   const int n = s.vertices;
   std::mt19937_64 rng(s.seed);
   std::uniform_real_distribution<double> unit(-1.0, 1.0);
   GnmmResult r;
   auto eval = [&](const Vector6d& x) {
     ++r.evaluations;
-    return f(x);
+    return (*f)(x);
   };
   auto draw = [&](const Vector6d& center, const Vector6d& half) {
     Vector6d x;
@@ -45,11 +55,19 @@ GnmmResult Gnmm::maximize(const Objective6& f, const Vector6d& initial) const {
   x[0] = initial;
   fx[0] = eval(initial);
   r.initial_value = fx[0];
+  if (screening) {  // J at the guess on the objective itself (J_guess, for the gate)
+    ++r.evaluations;
+    r.initial_value = full(initial);
+  }
   for (int i = 1; i < n; ++i) {
     x[i] = draw(initial, s.bounds);
     fx[i] = eval(x[i]);
   }
   for (r.iterations = 0; r.iterations < s.max_iterations;) {
+    if (screening && r.iterations == s.screen_iterations) {
+      f = &full;
+      for (int i = 0; i < n; ++i) fx[i] = eval(x[i]);
+    }
     ++r.iterations;
     // Worst (lowest f), second worst and best vertex.
     int worst = 0, best = 0;
@@ -103,6 +121,10 @@ GnmmResult Gnmm::maximize(const Objective6& f, const Vector6d& initial) const {
         }
       }
     }
+  }
+  if (f != &full) {  // every iteration screened: the population on the objective itself
+    f = &full;
+    for (int i = 0; i < n; ++i) fx[i] = eval(x[i]);
   }
   const int best = int(std::max_element(fx.begin(), fx.end()) - fx.begin());
   r.best = x[best];

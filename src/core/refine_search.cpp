@@ -46,12 +46,20 @@ RefineResult refineCandidates(std::vector<MultiScaleObjective>& objectives,
     throw std::invalid_argument("refineCandidates: fewer objectives than threads");
   }
   std::vector<CompassResult> results(candidates.size());
-  runOnThreads(int(candidates.size()), threads, [&](int k, int t) {
-    MultiScaleObjective& f = objectives[std::size_t(t)];
-    results[std::size_t(k)] =
-        compassMaximize([&f](const Vector6d& q) { return f(q); },
-                        f.variable(candidates[std::size_t(k)]), compass);
-  });
+  if (candidates.size() == 1 && threads >= 2 && objectives.size() >= 2) {
+    // One candidate: its poll on both threads (compassMaximizePaired, the same result).
+    MultiScaleObjective &f0 = objectives[0], &f1 = objectives[1];
+    results[0] = compassMaximizePaired([&f0](const Vector6d& q) { return f0(q); },
+                                       [&f1](const Vector6d& q) { return f1(q); },
+                                       f0.variable(candidates[0]), compass);
+  } else {
+    runOnThreads(int(candidates.size()), threads, [&](int k, int t) {
+      MultiScaleObjective& f = objectives[std::size_t(t)];
+      results[std::size_t(k)] =
+          compassMaximize([&f](const Vector6d& q) { return f(q); },
+                          f.variable(candidates[std::size_t(k)]), compass);
+    });
+  }
   RefineResult best;
   best.value = -1.0;
   for (std::size_t k = 0; k < results.size(); ++k) {

@@ -87,6 +87,8 @@ void validate(const RegistrationSettings& s) {
   requireInRange("collapse_fraction", s.collapse_fraction, 0.0, 1.0);
   requireInRange("dense_points", s.dense_points, 0, 1000);
   requireInRange("coarse_max_points", s.coarse_max_points, 0, 10000000);
+  requireInRange("screen_stride", s.screen_stride, 1, 64);
+  requireInRange("screen_final_iterations", s.screen_final_iterations, 0, 1000000);
 }
 
 std::string toString(RegistrationStatus status) {
@@ -111,8 +113,9 @@ struct CubeRegistration::ScanPoints {
   const PointArray* fine = nullptr;    ///< all points collapsed for the refine
   const PointArray* polish = nullptr;  ///< the polish's points (all points, collapsed)
   const PointArray* refine = nullptr;  ///< the refine's points (fine, or its dense part)
+  const PointArray* screen = nullptr;  ///< the coarse points thinned for the screening iterations
   PointArray dense_storage, coarse_storage, full_storage, fine_storage, refine_storage,
-      polish_storage, thinned_storage;
+      polish_storage, thinned_storage, screen_storage;
 };
 
 CubeRegistration::CubeRegistration(const RegistrationSettings& settings)
@@ -231,6 +234,19 @@ void CubeRegistration::prepareScan(const PointArray& scan, ScanPoints& p) const 
     }
     p.coarse = &p.thinned_storage;
   }
+  // Screening points for the coarse search (RegistrationSettings::screen_stride); not for a
+  // scan so small that the subset leaves J too few cubes to tell poses apart.
+  constexpr std::size_t kMinScreenPoints = 500;
+  const std::size_t stride = std::size_t(settings_.screen_stride);
+  if (stride > 1 && settings_.gnmm.max_iterations > settings_.screen_final_iterations &&
+      p.coarse->size() / stride >= kMinScreenPoints) {
+    const PointArray& all = *p.coarse;
+    p.screen_storage.reserve((all.size() + stride - 1) / stride);
+    for (std::size_t k = 0; k < all.size(); k += stride) {
+      p.screen_storage.push_back(all.x[k], all.y[k], all.z[k]);
+    }
+    p.screen = &p.screen_storage;
+  }
   if (!settings_.polish.enabled) return;
   const double pf = settings_.polish.collapse_fraction;
   p.polish = pf == rf   ? p.fine
@@ -307,7 +323,11 @@ void CubeRegistration::coarseStage(const ScanPoints& points, const Pose6& guess,
   const std::vector<CoincidenceObjective*> objectives = coarseObjectives(points);
   GnmmSettings gnmm = settings_.gnmm;
   gnmm.seed += std::uint64_t(attempt) * std::uint64_t(settings_.search.starts);
-  const CoarseSearchResult c = coarseSearch(objectives, gnmm, settings_.search, guess, seeds);
+  if (points.screen) {
+    gnmm.screen_iterations = gnmm.max_iterations - settings_.screen_final_iterations;
+  }
+  const CoarseSearchResult c =
+      coarseSearch(objectives, gnmm, settings_.search, guess, seeds, points.screen);
   res.pose = c.runs.front().best;
   res.J = res.J_coarse = int(c.runs.front().best_value);
   res.J_guess = c.J_guess;

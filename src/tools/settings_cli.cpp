@@ -81,6 +81,10 @@ std::string algorithmOptionsHelp() {
          "                        at most C times in sd; <= 1 = off (default " + num(d.polish.covariance_jackknife_cap) + ")\n"
          "  --coarse-max-points N the coarse search evaluates at most N collapsed points, 0 = all\n"
          "                        (default " + num(d.coarse_max_points) + ")\n"
+         "  --screen S F          the coarse search's GNMM iterations but the last F evaluate\n"
+         "                        every S-th coarse point, the last F all; S = 1 = off\n"
+         "                        (default " + std::to_string(d.screen_stride) + " " +
+         std::to_string(d.screen_final_iterations) + ")\n"
          "  --refine-collapse F   the refine stage evaluates one point per voxel of F*E\n"
          "                        (default " + num(d.refine.collapse_fraction) + ")\n"
          "  --refine-grids K      refine on the sum of J over K fine grids shifted by 1/K cube\n"
@@ -177,6 +181,8 @@ bool parseAlgorithmOption(const std::vector<std::string>& args, std::size_t& i,
     s.refine.candidates = int(value(1)), used = 2;
   } else if (a == "--coarse-max-points") {
     s.coarse_max_points = int(value(1)), used = 2;
+  } else if (a == "--screen") {
+    s.screen_stride = int(value(1)), s.screen_final_iterations = int(value(2)), used = 3;
   } else if (a == "--refine-collapse") {
     s.refine.collapse_fraction = value(1), used = 2;
   } else if (a == "--refine-grids") {

@@ -78,4 +78,37 @@ TEST(Gnmm, SettingsOutOfRangeAreRefused) {
   s = GnmmSettings{};
   s.max_iterations = 0;
   EXPECT_THROW(Gnmm{s}, std::invalid_argument);
+  s = GnmmSettings{};
+  s.screen_iterations = s.max_iterations + 1;
+  EXPECT_THROW(Gnmm{s}, std::invalid_argument);
+}
+
+// Screening: the first iterations climb a cheap, coarser version of f (its terraces 4x wider,
+// as J on a quarter of the points), the last ones f itself. The result and J at the start are
+// f's values, the screened iterations cost the screen's evaluations, and the optimum is found
+// to f's own resolution.
+TEST(Gnmm, ScreensOnACheapObjectiveThenClimbsTheObjective) {
+  int f_calls = 0, screen_calls = 0;
+  const auto terraces = [](const Vector6d& x, double width) {
+    double v = 100;
+    for (int k = 0; k < 6; ++k) v -= std::floor(std::abs(x[k] - kOptimum[k]) / ((k < 3 ? 0.05 : 0.01) * width));
+    return v;
+  };
+  const Objective6 f = [&](const Vector6d& x) { return ++f_calls, terraces(x, 1.0); };
+  const Objective6 screen = [&](const Vector6d& x) { return ++screen_calls, terraces(x, 4.0); };
+  GnmmSettings s = bounds(1.0, 0.15);
+  s.screen_iterations = 400;  // of 500
+  const GnmmResult r = Gnmm(s).maximize(screen, f, distantStart());
+  EXPECT_EQ(r.best_value, 100.0);
+  EXPECT_EQ(r.best_value, terraces(r.best, 1.0));
+  EXPECT_EQ(r.initial_value, terraces(distantStart(), 1.0));
+  EXPECT_LT((r.best.head<3>() - kOptimum.head<3>()).cwiseAbs().maxCoeff(), 0.05);
+  EXPECT_LT((r.best.tail<3>() - kOptimum.tail<3>()).cwiseAbs().maxCoeff(), 0.01);
+  EXPECT_EQ(f_calls + screen_calls, r.evaluations);
+  EXPECT_GT(screen_calls, 3 * f_calls);  // most of the work on the screen
+  // Without screening iterations, the screen is never called.
+  s.screen_iterations = 0;
+  screen_calls = 0;
+  Gnmm(s).maximize(screen, f, distantStart());
+  EXPECT_EQ(screen_calls, 0);
 }

@@ -353,6 +353,42 @@ TEST(Registration, ACapOnTheCoarsePointsKeepsTheResult) {
   EXPECT_LT(rad2deg(Eigen::AngleAxisd(r.transform.linear().transpose() * s.T_first_second.linear()).angle()), 0.1);
 }
 
+// Screening (screen_stride 4): the coarse search's early iterations on a quarter of the points
+// find the known transform as the search without screening does; J and J at the guess count
+// every coarse point.
+TEST(Registration, ScreeningKeepsTheResult) {
+  const Scans s = makeScans(sim::SceneType::Urban, 1);
+  const Pose6 truth = isometryToPose(s.T_first_second);
+  Pose6 guess = truth;
+  guess.head<3>() += Eigen::Vector3d(0.6, -0.5, 0.1);
+  guess[5] += deg2rad(5.0);
+  RegistrationSettings settings;
+  EXPECT_EQ(settings.screen_stride, 1);  // off by default
+  settings.screen_stride = 4;
+  CubeRegistration screened(settings);
+  screened.setReference(s.first);
+  settings.screen_stride = 1;
+  CubeRegistration plain(settings);
+  plain.setReference(s.first);
+  const RegistrationResult a = screened.align(s.second, guess);
+  const RegistrationResult b = plain.align(s.second, guess);
+  ASSERT_TRUE(a.ok() && b.ok());
+  ASSERT_GT(a.points_used, 4 * 500u);  // enough points to screen
+  EXPECT_EQ(a.J_guess, b.J_guess);     // J at the guess on all coarse points
+  EXPECT_EQ(a.J, screened.score(s.second, a.pose));
+  for (const RegistrationResult* r : {&a, &b}) {
+    EXPECT_LT((r->transform.translation() - s.T_first_second.translation()).norm(), 0.02);
+    EXPECT_LT(rad2deg(Eigen::AngleAxisd(r->transform.linear().transpose() * s.T_first_second.linear()).angle()), 0.1);
+  }
+  EXPECT_LT((a.transform.translation() - b.transform.translation()).norm(), 0.005);
+  // Screening iterations outside [0, iterations] are refused.
+  settings.screen_stride = 0;
+  EXPECT_THROW(CubeRegistration{settings}, std::invalid_argument);
+  settings.screen_stride = 4;
+  settings.screen_final_iterations = -1;
+  EXPECT_THROW(CubeRegistration{settings}, std::invalid_argument);
+}
+
 }  // namespace
 
 // The "no motion" maximum (dense_sampling.h): two sweeps 1.5 m apart along the street of a

@@ -76,8 +76,12 @@ struct CoarseSearchResult {
 /// `guess` (start k >= 1 from seeds[k - 1] where there is one: the planar grid's maxima), each
 /// taken by the next free thread t with objectives[t] (each thread's own working copy of the E
 /// grid, bound to the same scan). Needs objectives.size() >= min(search.threads, search.starts).
+/// With `screen` (a subset of the objectives' scan) and gnmm.screen_iterations > 0, each start
+/// runs its first screen_iterations on `screen` (Gnmm::maximize with a screening objective);
+/// the objectives are bound to their own scan again on return.
 CoarseSearchResult coarseSearch(const std::vector<CoincidenceObjective*>& objectives,
                                 const GnmmSettings& gnmm, const SearchSettings& search,
-                                const Pose6& guess, const std::vector<Pose6>& seeds = {});
+                                const Pose6& guess, const std::vector<Pose6>& seeds = {},
+                                const PointArray* screen = nullptr);
 
 }  // namespace cube_scan_matcher

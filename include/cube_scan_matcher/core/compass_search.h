@@ -26,6 +26,9 @@ struct CompassResult {
   double initial_value = 0.0;
   int evaluations = 0;
   int moves = 0;  ///< accepted steps
+  /// compassMaximizePaired: points evaluated ahead that a move made useless (not counted in
+  /// evaluations).
+  int speculated = 0;
 };
 
 /// At each level, try -step and +step along each of the 6 axes in turn from the current point,
@@ -34,5 +37,14 @@ struct CompassResult {
 /// point a move left is not evaluated again), so a level ends after 12 failures in a row.
 CompassResult compassMaximize(const Objective6& f,
                               const Vector6d& initial, const CompassSettings& settings);
+
+/// The same search on two threads: while f0 evaluates the point the poll proposes (on the
+/// calling thread), f1 evaluates the point it proposes next if that one fails (on a second
+/// thread). f0 and f1 must be the same function (each with its own working memory). Most
+/// polls fail (a level ends after 12 failures in a row), so most pairs are both used; after a
+/// move the second is dropped (CompassResult::speculated). The moves, the result and the
+/// evaluations counted are compassMaximize's, bit for bit.
+CompassResult compassMaximizePaired(const Objective6& f0, const Objective6& f1,
+                                    const Vector6d& initial, const CompassSettings& settings);
 
 }  // namespace cube_scan_matcher

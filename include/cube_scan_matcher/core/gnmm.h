@@ -23,6 +23,10 @@ struct GnmmSettings {
   double expansion = 2.0;     ///< gamma > 1.
   double contraction = 0.5;   ///< rho in (0, 1).
   std::uint64_t seed = 42;    ///< RNG seed: equal seeds give equal runs.
+  /// Iterations (of max_iterations) run on the screening objective first, when maximize() is
+  /// given one; the population is then evaluated again on the objective and the rest run on
+  /// it. In [0, max_iterations].
+  int screen_iterations = 0;
 };
 
 /// Throws std::invalid_argument naming the bad setting.
@@ -44,6 +48,10 @@ class Gnmm {
   /// Maximises f starting from `initial`. The population is the initial estimate plus N-1
   /// vertices drawn uniformly within +-bounds around it.
   GnmmResult maximize(const Objective6& f, const Vector6d& initial) const;
+
+  /// The same, with the first screen_iterations run on `screen` (a cheaper approximation of f:
+  /// f on a subset of the points); best_value and initial_value are f's.
+  GnmmResult maximize(const Objective6& screen, const Objective6& f, const Vector6d& initial) const;
 
  private:
   GnmmSettings settings_;

@@ -53,8 +53,10 @@ struct RefineResult {
 };
 
 /// Compass search from each candidate (at least one), on up to `threads` threads, each with
-/// objectives[thread]; the highest value wins (ties: the earlier candidate). Needs
-/// objectives.size() >= min(threads, candidates.size()).
+/// objectives[thread]; the highest value wins (ties: the earlier candidate). A single
+/// candidate with threads >= 2 and two objectives is searched on both threads
+/// (compassMaximizePaired: the same result). Needs objectives.size() >= min(threads,
+/// candidates.size()).
 RefineResult refineCandidates(std::vector<MultiScaleObjective>& objectives,
                               const std::vector<Pose6>& candidates,
                               const CompassSettings& compass, int threads);

@@ -60,6 +60,17 @@ struct RegistrationSettings {
   /// evenly spaced in scan order (J at the result and the gate's J use them all). 0 = all.
   /// In [0, 1e7].
   int coarse_max_points = 0;
+  /// Beyond the paper, off by default: each GNMM start of the coarse search screens first.
+  /// Its iterations but the last screen_final_iterations evaluate J on every screen_stride-th
+  /// coarse point (evenly spaced in scan order), then the population is evaluated on all
+  /// points and the last iterations climb there: about (iterations - final) / stride + final
+  /// full evaluations per start instead of iterations (300 iterations, stride 4, 50 final:
+  /// 0.42x). It halves the coarse stage on the real sequence with the same drift, but costs
+  /// successes in the open square and false accepts on the wall with the sensor's artefacts
+  /// (docs/experiments.md, "Screening the coarse search"). Not used on scans with fewer than
+  /// 500 x stride coarse points. 1 = off. In [1, 64] and [0, 1e6].
+  int screen_stride = 1;
+  int screen_final_iterations = 50;
 
   /// The paper's fixed mode: one GNMM of 15 vertices and 500 iterations on all points,
   /// restarts around the initial estimate within +-1 m / +-8 deg, no refine stage.
