@@ -9,12 +9,15 @@
 #
 # The base's worktree stays for the next comparison; `git worktree prune` after removing it.
 #
-# usage: bash scripts/online_ab.sh BASE SEQUENCE_DIR OUT_DIR [ROUNDS=2] [SIMD=avx2]
+# With NEW_OPTIONS, the new side runs with those sequence_benchmark options (BASE = HEAD: an
+# option against the defaults, in the same code).
+#
+# usage: bash scripts/online_ab.sh BASE SEQUENCE_DIR OUT_DIR [ROUNDS=2] [SIMD=avx2] [NEW_OPTIONS]
 #        bash scripts/online_ab.sh --summarize OUT_DIR [ROUNDS=2]   (the summary of runs made)
 #   e.g. bash scripts/online_ab.sh origin/main ../shared/data/balm_os0_hall_seq_a /tmp/ab
 set -euo pipefail
 cd "$(dirname "$0")/.."
-usage="usage: bash scripts/online_ab.sh BASE SEQUENCE_DIR OUT_DIR [ROUNDS=2] [SIMD=avx2] | --summarize OUT_DIR [ROUNDS=2]"
+usage="usage: bash scripts/online_ab.sh BASE SEQUENCE_DIR OUT_DIR [ROUNDS=2] [SIMD=avx2] [NEW_OPTIONS] | --summarize OUT_DIR [ROUNDS=2]"
 export PATH=/usr/sbin:/usr/bin:/sbin:/bin:$PATH
 if [ "${1:-}" = --summarize ]; then
   [ $# -ge 2 ] || { echo "$usage" >&2; exit 2; }
@@ -22,7 +25,7 @@ if [ "${1:-}" = --summarize ]; then
   head -4 "$OUT/summary.txt" > "$OUT/summary.tmp" && mv "$OUT/summary.tmp" "$OUT/summary.txt"
 else
 [ $# -ge 3 ] || { echo "$usage" >&2; exit 2; }
-BASE="$1" SEQ="$(cd "$2" && pwd)" OUT="$3" ROUNDS="${4:-2}" SIMD="${5:-avx2}"
+BASE="$1" SEQ="$(cd "$2" && pwd)" OUT="$3" ROUNDS="${4:-2}" SIMD="${5:-avx2}" NEW_OPTIONS="${6:-}"
 mkdir -p "$OUT"
 OUT="$(cd "$OUT" && pwd)"
 base_rev="$(git rev-parse --verify "$BASE^{commit}")"
@@ -39,7 +42,7 @@ declare -A BIN=([base]="$WT/build/devel/lib/cube_scan_matcher/sequence_benchmark
                 [new]="build/devel/lib/cube_scan_matcher/sequence_benchmark")
 {
   echo "base: $base_rev"
-  echo "new: $(git rev-parse HEAD)$(git diff --quiet HEAD -- src include || echo ' + uncommitted changes')"
+  echo "new: $(git rev-parse HEAD)$(git diff --quiet HEAD -- src include || echo ' + uncommitted changes')${NEW_OPTIONS:+, options: $NEW_OPTIONS}"
   echo "sequence: $SEQ; vector path: $SIMD; rounds: $ROUNDS (base and new alternate)"
   echo "cpu: $(lscpu | sed -n 's/^Model name: *//p' | head -1), $(nproc) cores"
 } > "$OUT/summary.txt"
@@ -47,8 +50,10 @@ for round in $(seq 1 "$ROUNDS"); do
   for side in base new; do
     for odometry in big cv; do
       name="${side}_${odometry}_${round}"
+      options=()
+      [ "$side" = new ] && read -r -a options <<< "$NEW_OPTIONS"
       "${BIN[$side]}" --dir "$SEQ" --odometry "$odometry" --methods cubes --simd "$SIMD" \
-        --csv "$OUT/$name.csv" > "$OUT/$name.log" 2>&1
+        "${options[@]}" --csv "$OUT/$name.csv" > "$OUT/$name.log" 2>&1
       echo "ran $name"
     done
   done

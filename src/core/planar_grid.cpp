@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <stdexcept>
+#include <vector>
 
 #include "cube_scan_matcher/core/parallel.h"
 #include "require_in_range.h"
@@ -53,8 +54,34 @@ PlanarGridResult planarGridMaxima(const std::vector<CoincidenceObjective*>& obje
   auto index = [&](int k, int i, int j) { return (std::size_t(k) * sx + std::size_t(i)) * sx + std::size_t(j); };
   runOnThreads(sk, threads, [&](int k, int t) {
     CoincidenceObjective& f = *objectives[std::size_t(t)];
+    const PointArray* scan = f.scan();
+    if (!scan || scan->empty()) return;  // J = 0 everywhere, as evaluate() gives
+    // The poses of a yaw slice differ in translation only: the scan is rotated once (u = A p)
+    // and each pose's cube indices are those of u + b (cube_grid.h: the indices evaluate()
+    // computes, bit for bit).
+    const CubeGrid& grid = f.grid();
+    const std::size_t n = scan->size();
+    thread_local std::vector<float> ux, uy, uz;
+    ux.resize(n), uy.resize(n), uz.resize(n);
+    const auto affineAt = [&](int i, int j) {
+      const Eigen::Isometry3d pose = poseToIsometry(poseAt(k, i, j));
+      return grid.affine(pose.linear().cast<float>(), pose.translation().cast<float>());
+    };
+    rotatePoints(affineAt(0, 0).a, scan->x.data(), scan->y.data(), scan->z.data(), n, ux.data(),
+                 uy.data(), uz.data());
+    std::int32_t idx[CoincidenceObjective::kBlock];
     for (int i = 0; i < sx; ++i) {
-      for (int j = 0; j < sx; ++j) J[index(k, i, j)] = f(poseAt(k, i, j));
+      for (int j = 0; j < sx; ++j) {
+        const GridAffine g = affineAt(i, j);
+        f.startCount();
+        for (std::size_t begin = 0; begin < n; begin += CoincidenceObjective::kBlock) {
+          const std::size_t m = std::min(CoincidenceObjective::kBlock, n - begin);
+          cubeIndicesFromRotated(1.0f, g.b, grid.dimsF(), ux.data() + begin, uy.data() + begin,
+                                 uz.data() + begin, m, f.outsideIndex(), idx);
+          f.countBlock(idx, m);
+        }
+        J[index(k, i, j)] = f.finishCount();
+      }
     }
   });
   res.evaluations = int(J.size());

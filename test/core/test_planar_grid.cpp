@@ -47,9 +47,20 @@ TEST(PlanarGrid, BestMaximumIsTheGridPoseNearestTheTruth) {
   EXPECT_NEAR(two.maxima[0][0], 1.0, 1e-9);
   EXPECT_NEAR(two.maxima[0][1], -0.5, 1e-9);
   EXPECT_NEAR(two.maxima[0][5], deg2rad(30), 1e-9);
-  EXPECT_EQ(two.maxima_J[0], a(two.maxima[0]));
-  for (std::size_t k = 1; k < two.maxima.size(); ++k) {
-    EXPECT_LE(two.maxima_J[k], two.maxima_J[k - 1]);
+  // J on the grid (the scan rotated once per yaw) is J as evaluate() counts it, at every
+  // maximum; they come best first.
+  for (std::size_t k = 0; k < two.maxima.size(); ++k) {
+    EXPECT_EQ(two.maxima_J[k], a(two.maxima[k])) << "maximum " << k;
+    if (k > 0) {
+      EXPECT_LE(two.maxima_J[k], two.maxima_J[k - 1]);
+    }
+  }
+  Pose6 off_centre = Pose6::Zero();
+  off_centre << 0.13, -0.07, 0.02, 0.01, -0.005, deg2rad(1.3);
+  const PlanarGridResult off = planarGridMaxima({&a, &b}, g, off_centre, 40, 2);
+  ASSERT_GE(off.maxima.size(), 3u);
+  for (std::size_t k = 0; k < off.maxima.size(); ++k) {
+    EXPECT_EQ(off.maxima_J[k], b(off.maxima[k])) << "maximum " << k;
   }
   // The result does not depend on the thread count.
   const PlanarGridResult one = planarGridMaxima({&a}, g, Pose6::Zero(), 3, 1);
