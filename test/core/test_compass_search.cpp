@@ -62,16 +62,17 @@ CompassResult restartingPasses(const Objective6& f, const Vector6d& initial,
   }
   return r;
 }
+
+// A rugged function (a tilted peak plus ripples) so that moves come in every order.
+double rugged(const Vector6d& x) {
+  const Vector6d peak = (Vector6d() << 0.41, -0.27, 0.13, 0.05, -0.03, 0.02).finished();
+  const Vector6d d = x - peak;
+  return -d.cwiseAbs().sum() - 0.3 * d.squaredNorm() + 0.02 * std::sin(40.0 * x.sum());
+}
 }  // namespace
 
 TEST(CompassSearch, MakesTheSameMovesAsRestartingEachPassWithFewerEvaluations) {
-  // A rugged function (a tilted peak plus ripples) so that moves come in every order.
-  Vector6d peak;
-  peak << 0.41, -0.27, 0.13, 0.05, -0.03, 0.02;
-  auto f = [&](const Vector6d& x) {
-    const Vector6d d = x - peak;
-    return -d.cwiseAbs().sum() - 0.3 * d.squaredNorm() + 0.02 * std::sin(40.0 * x.sum());
-  };
+  const auto f = rugged;
   CompassSettings s;
   s.levels = 6;
   int total_new = 0, total_old = 0;
@@ -94,12 +95,7 @@ TEST(CompassSearch, MakesTheSameMovesAsRestartingEachPassWithFewerEvaluations) {
 // point: the same result, moves and evaluation count, on the rugged function above and under a
 // budget that ends mid-pair; the second objective does part of the work.
 TEST(CompassSearch, PairedPollMakesTheSameMovesAsTheSerialOne) {
-  Vector6d peak;
-  peak << 0.41, -0.27, 0.13, 0.05, -0.03, 0.02;
-  auto f = [&](const Vector6d& x) {
-    const Vector6d d = x - peak;
-    return -d.cwiseAbs().sum() - 0.3 * d.squaredNorm() + 0.02 * std::sin(40.0 * x.sum());
-  };
+  const auto f = rugged;
   for (const int budget : {2000, 37, 2}) {
     CompassSettings s;
     s.levels = 6;
