@@ -168,44 +168,6 @@ double OnlineMatcher::gateScale(double stamp, double since) const {
   return std::clamp(std::round((stamp - since) / period), 1.0, kMaxGateScale);
 }
 
-void OnlineMatcher::deskewScan(OnlineStep& step, const PointArray& points,
-                               const PointTimes& times, double interval, const Twist& placed,
-                               const Keyframe& keyframe, const GateSettings& gate_settings,
-                               std::optional<PointArray>& out) {
-  // The velocity the points were placed with (`placed`), and the registered one: the motion
-  // since the last known scan, anchor * increment (anchor = T_known_keyframe), over `interval`
-  // (core/deskew.h).
-  const Eigen::Isometry3d anchor = last_known_->pose.inverse() * keyframe.pose;
-  const auto registered = [&](const Eigen::Isometry3d& increment) {
-    return velocityOf(anchor * increment, interval);
-  };
-  const auto start = std::chrono::steady_clock::now();
-  for (int round = 0; round < settings_.deskew.iterations; ++round) {
-    ++step.work.deskew_rounds;
-    // The pose at which every line lies on the reference (plane_polish.h), then a full
-    // registration of the sweep re-placed there: the result the gate judges.
-    const SweepPolishResult sp = registration_.polishSweep(points, times.tau, interval, placed, anchor,
-                                                           step.result.pose, 20);
-    if (!sp.applied) break;
-    out = points;
-    deskew(*out, times.tau, placed, registered(poseToIsometry(sp.pose)));
-    RegistrationResult again = registration_.align(*out, sp.pose);
-    countAlign(step.work, again);
-    if (!again.ok() || gate(again, step.guess, gate_settings) != GateReason::Accepted) break;
-    const Eigen::Isometry3d change = step.increment.inverse() * again.transform;
-    step.result = std::move(again);
-    step.increment = step.result.transform;
-    step.correction = correctionFromGuess(step.guess, step.result.pose);
-    ++step.reregistered;
-    if (change.translation().norm() < 1e-3 && Eigen::AngleAxisd(change.linear()).angle() < 1.745e-4) break;
-  }
-  // The keyframe's points: re-placed with the final motion (from the scan as given).
-  out = points;
-  deskew(*out, times.tau, placed, registered(step.increment));
-  step.deskewed = true;
-  step.work.deskew_s = secondsSince(start);
-}
-
 namespace {
 
 void appendMessage(OnlineStep& step, const std::string& text) {
@@ -221,6 +183,70 @@ bool takenOverTime(const PointTimes* times) {
 }
 
 }  // namespace
+
+void OnlineMatcher::deskewScan(OnlineStep& step, const PointArray& points,
+                               const PointTimes& times, double interval, const Twist& placed,
+                               const Keyframe& keyframe, const GateSettings& gate_settings,
+                               std::optional<PointArray>& out) {
+  // The velocity the points were placed with (`placed`), and the registered one: the motion
+  // since the last known scan, anchor * increment (anchor = T_known_keyframe), over `interval`
+  // (core/deskew.h).
+  const Eigen::Isometry3d anchor = last_known_->pose.inverse() * keyframe.pose;
+  const auto registered = [&](const Eigen::Isometry3d& increment) {
+    return velocityOf(anchor * increment, interval);
+  };
+  // The rigid registration of a bent sweep only starts the de-skew (a rigid result is a
+  // compromise between the sweep's lines, and the gate accepts most of them where they are
+  // wrong: BENCHMARK.md, "Sweeps taken while driving"); the first round's registration of the
+  // re-placed sweep is the verdict, accepted or not. A later round that is rejected keeps the
+  // round before it.
+  const Eigen::Isometry3d predicted_increment = step.increment;
+  const auto start = std::chrono::steady_clock::now();
+  for (int round = 0; round < settings_.deskew.iterations; ++round) {
+    ++step.work.deskew_rounds;
+    // The pose at which every line lies on the reference (plane_polish.h), then a full
+    // registration of the sweep re-placed there: the result the gate judges.
+    const SweepPolishResult sp = registration_.polishSweep(points, times.tau, interval, placed, anchor,
+                                                           step.result.pose, 20);
+    RegistrationResult again;
+    GateReason reason = GateReason::Uncertain;  // no polish: the sweep's motion is unknown
+    if (sp.applied) {
+      out = points;
+      deskew(*out, times.tau, placed, registered(poseToIsometry(sp.pose)));
+      again = registration_.align(*out, sp.pose);
+      countAlign(step.work, again);
+      reason = again.ok() ? gate(again, step.guess, gate_settings) : GateReason::BadInput;
+    }
+    if (reason != GateReason::Accepted) {
+      if (round == 0) {
+        step.accepted = false;
+        step.reason = reason;
+        step.increment = predicted_increment;
+        if (again.ok()) step.result = std::move(again);
+        if (!sp.applied) appendMessage(step, "sweep polish not applied (" + sp.reason + ")");
+      }
+      break;
+    }
+    const Eigen::Isometry3d change = step.increment.inverse() * again.transform;
+    step.result = std::move(again);
+    step.increment = step.result.transform;
+    step.correction = correctionFromGuess(step.guess, step.result.pose);
+    step.accepted = true;
+    step.reason = GateReason::Accepted;
+    ++step.reregistered;
+    if (change.translation().norm() < 1e-3 && Eigen::AngleAxisd(change.linear()).angle() < 1.745e-4) break;
+  }
+  step.work.deskew_s = secondsSince(start);
+  if (!step.accepted) {
+    out.reset();  // a rejected scan is never a keyframe's points
+    return;
+  }
+  // The keyframe's points: re-placed with the final motion (from the scan as given).
+  out = points;
+  deskew(*out, times.tau, placed, registered(step.increment));
+  step.deskewed = true;
+}
+
 
 OnlineStep OnlineMatcher::process(const PointArray& points, double stamp,
                                   const std::optional<Eigen::Isometry3d>& given_odom,
@@ -246,7 +272,9 @@ OnlineStep OnlineMatcher::process(const PointArray& points, double stamp,
     step.reason = GateReason::BadInput;
   } else {
     registerAndGate(step, points, stamp, predicted.from, *keyframe);
-    if (step.accepted && takenOverTime(times) && settings_.deskew.enabled && last_known_ &&
+    // A sweep taken over time is de-skewed whenever its rigid registration found a pose, even
+    // one the gate rejected: the de-skewed registration decides.
+    if (step.result.ok() && takenOverTime(times) && settings_.deskew.enabled && last_known_ &&
         stamp > last_known_->stamp) {
       deskewScan(step, points, *times, stamp - last_known_->stamp, placed, *keyframe,
                  scaledGate(step.gate_scale), deskewed);

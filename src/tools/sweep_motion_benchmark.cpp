@@ -64,6 +64,8 @@ void usage(std::ostream& os) {
         "                      yaw rate <= W [deg/s] (repeatable)\n"
         "  --max-accepted-wrong MODE:N  exit 2 when more than N of MODE's increments (the\n"
         "                      first ones included) were accepted without success\n"
+        "  --min-success MODE:F  exit 2 when fewer than the fraction F of MODE's increments\n"
+        "                      (the first ones included) succeeded\n"
      << algorithmOptionsHelp();
 }
 
@@ -84,7 +86,13 @@ struct Row {
   int world, trial, k;
   bool accepted;
   double es, ea, time;
+  // The error of the registration itself: the pose relative to the last accepted scan's (or
+  // the first scan's) against the truth of the same. It differs from es/ea after a rejection,
+  // whose pose is the prediction.
+  double es_reg, ea_reg;
+  std::string reason;
   bool success() const { return es < 0.10 && ea < 1.0; }
+  bool registrationRight() const { return es_reg < 0.10 && ea_reg < 1.0; }
 };
 
 /// The sweeps of one run: moving (in base_link at the reference time, placed by odometry, with
@@ -144,6 +152,8 @@ int main(int argc, char** argv) {
   std::vector<Check> checks;
   std::string wrong_cap_mode;  // --max-accepted-wrong MODE:N (empty: no limit)
   int wrong_cap = 0;
+  std::string success_floor_mode;  // --min-success MODE:F (empty: no floor)
+  double success_floor = 0.0;
   int worlds = 3, sweeps = 5;
   bool from_rest = true;
   std::uint64_t seed = 1;
@@ -185,6 +195,14 @@ int main(int argc, char** argv) {
       wrong_cap = ArgReader::convert<int>("--max-accepted-wrong", v.substr(colon + 1));
       if (wrong_cap < 0) throw std::invalid_argument("--max-accepted-wrong: N must be >= 0");
     };
+    auto success_floor_of = [&](const std::string& v) {
+      const std::size_t colon = v.find(':');
+      if (colon == std::string::npos) throw std::invalid_argument("--min-success: MODE:F");
+      success_floor_mode = v.substr(0, colon);
+      success_floor = io::parseNumber("--min-success", v.substr(colon + 1));
+      if (!(success_floor >= 0.0 && success_floor <= 1.0))
+        throw std::invalid_argument("--min-success: F must be in [0, 1]");
+    };
     for (ArgReader r(argc, argv); r.more();) {
       if (r.help()) return usage(std::cout), 0;
       if (r.algorithm(settings.registration, filter) ||
@@ -196,7 +214,8 @@ int main(int argc, char** argv) {
           r.optionWith("--modes", [&](const std::string& v) { modes = splitList(v); }) ||
           r.optionWith("--start", start_of) || r.option("--trial-seed", seed) ||
           r.option("--csv", csv_path) || r.optionWith("--check", check_of) ||
-          r.optionWith("--max-accepted-wrong", wrong_cap_of))
+          r.optionWith("--max-accepted-wrong", wrong_cap_of) ||
+          r.optionWith("--min-success", success_floor_of))
         continue;
       r.unknown();
     }
@@ -204,6 +223,9 @@ int main(int argc, char** argv) {
     if (!wrong_cap_mode.empty() &&
         std::find(modes.begin(), modes.end(), wrong_cap_mode) == modes.end())
       throw std::invalid_argument("--max-accepted-wrong: mode " + wrong_cap_mode + " is not run");
+    if (!success_floor_mode.empty() &&
+        std::find(modes.begin(), modes.end(), success_floor_mode) == modes.end())
+      throw std::invalid_argument("--min-success: mode " + success_floor_mode + " is not run");
     if (sweeps < 3) throw std::invalid_argument("--sweeps must be >= 3");
     for (const Motion& m : motions) {
       if (!(m.speed >= 0.0 && m.speed <= 5.0) || !(std::abs(m.yaw_rate_deg) <= 90.0))
@@ -228,7 +250,7 @@ int main(int argc, char** argv) {
 
     CsvWriter csv(csv_path,
                   "scene,world,trial,speed_mps,yaw_rate_dps,duration_s,odometry,mode,k,accepted,"
-                  "success,Es_m,Ea_deg,time_s");
+                  "success,Es_m,Ea_deg,time_s,Es_reg_m,Ea_reg_deg,reason");
     const sim::ScannerModel model;
     std::vector<Row> rows;
     int trial = 0;
@@ -262,6 +284,7 @@ int main(int argc, char** argv) {
                 if (mode.size() > 6) s.deskew.iterations = mode[6] - '0';
                 OnlineMatcher matcher(s);
                 std::vector<Eigen::Isometry3d> poses;
+                int last_accepted = 0;  // the first scan's pose is the chain's origin
                 for (int k = 0; k < sweeps; ++k) {
                   const bool rigid_input = mode == "static" || mode == "ideal" || (from_rest && k == 0);
                   PointTimes times;  // placed by the odometry, as an assembler in odom gives it
@@ -278,11 +301,17 @@ int main(int argc, char** argv) {
                   if (k == 0) continue;
                   const PoseError e = poseError(poses[k - 1].inverse() * poses[k],
                                                 run.truth[k - 1].inverse() * run.truth[k]);
+                  const int j = last_accepted;
+                  const PoseError r = poseError(poses[j].inverse() * poses[k],
+                                                run.truth[j].inverse() * run.truth[k]);
+                  if (step.accepted) last_accepted = k;
                   Row row{scene_name, odometry_models[o], mode, motion, duration, w, trial, k,
-                          step.accepted, e.es_m, e.ea_deg, seconds};
+                          step.accepted, e.es_m, e.ea_deg, seconds, r.es_m, r.ea_deg,
+                          toString(step.reason)};
                   csv << row.scene << w << trial << motion.speed << motion.yaw_rate_deg
                       << duration << row.odometry << mode << k << int(row.accepted)
-                      << int(row.success()) << row.es << row.ea << row.time;
+                      << int(row.success()) << row.es << row.ea << row.time << row.es_reg
+                      << row.ea_reg << row.reason;
                   csv.endRow();
                   rows.push_back(row);
                 }
@@ -347,13 +376,21 @@ int main(int argc, char** argv) {
       if (median(es) > ch.es || median(ea) > ch.ea) failures.push_back("--check " + ch.mode + " missed");
     }
     std::map<std::string, std::pair<int, int>> wrong;  // mode: accepted wrong, increments
+    std::map<std::string, int> succeeded;                // mode: increments with success
     for (const Row& r : rows) {
       wrong[r.mode].first += r.accepted && !r.success();
       ++wrong[r.mode].second;
+      succeeded[r.mode] += r.success();
     }
     for (const auto& [mode, count] : wrong) {
-      std::printf("%s: %d of %d increments accepted without success\n", mode.c_str(),
-                  count.first, count.second);
+      std::printf("%s: %d of %d increments accepted without success, %d succeeded\n",
+                  mode.c_str(), count.first, count.second, succeeded[mode]);
+    }
+    if (!success_floor_mode.empty() &&
+        succeeded[success_floor_mode] < success_floor * wrong[success_floor_mode].second) {
+      failures.push_back("--min-success " + success_floor_mode + ": " +
+                         std::to_string(succeeded[success_floor_mode]) + " of " +
+                         std::to_string(wrong[success_floor_mode].second) + " succeeded");
     }
     if (!wrong_cap_mode.empty() && wrong[wrong_cap_mode].first > wrong_cap) {
       failures.push_back("--max-accepted-wrong " + wrong_cap_mode + ": " +

@@ -33,17 +33,20 @@ struct KeyframeSettings {
 
 /// De-skew with the corrected motion (core/deskew.h), for scans given with per-point times.
 struct DeskewSettings {
-  /// After an accepted registration, find the pose at which every line of the sweep lies on
-  /// the reference when re-placed with the motion that pose implies (a continuous-time polish,
-  /// plane_polish.h polishSweepOnPlanes), register the sweep re-placed there again, and keep
-  /// the sweep re-placed with the final registered motion (instead of the odometry's, or none)
-  /// as the keyframe. Constant velocity since the last known scan. Only scans given with
-  /// point times that differ (a sweep taken over time) are touched.
+  /// After the rigid registration found a pose (accepted by the gate or not), find the pose
+  /// at which every line of the sweep lies on the reference when re-placed with the motion
+  /// that pose implies (a continuous-time polish, plane_polish.h polishSweepOnPlanes),
+  /// register the sweep re-placed there again, and keep the sweep re-placed with the final
+  /// registered motion (instead of the odometry's, or none) as the keyframe. The gate's verdict
+  /// on the first round's registration is the scan's: the rigid registration of a bent sweep
+  /// is a compromise between its lines, often wrong where the gate cannot tell. Constant
+  /// velocity since the last known scan. Only scans given with point times that differ (a
+  /// sweep taken over time) are touched.
   bool enabled = true;
   /// Rounds of polish + registration (each about one registration's time; it stops early
-  /// once a round moves the result less than 1 mm and 0.01 deg, or the gate rejects a round's
-  /// result, which is then not used). 0: only re-place the sweep with the first result's
-  /// motion. In [0, 10].
+  /// once a round moves the result less than 1 mm and 0.01 deg, or the gate rejects a later
+  /// round's result, which is then not used). 0: the rigid registration's verdict, the sweep
+  /// re-placed with its motion. In [0, 10].
   int iterations = 2;
 };
 
@@ -260,9 +263,10 @@ class OnlineMatcher {
                    const std::optional<Eigen::Isometry3d>& odom, const Keyframe* keyframe,
                    bool refused);
   static void describe(OnlineStep& step);
-  /// De-skews an accepted scan with the registered motion over `interval` [s] since
-  /// last_known_ into `out`, and registers it once more if the settings say so (keeping the
-  /// second result only if the gate accepts it).
+  /// De-skews a scan whose rigid registration found a pose with the registered motion over
+  /// `interval` [s] since last_known_ into `out`, and registers it again: the first round's
+  /// result is the step's verdict (accepted or rejected), a later round's is kept only if the
+  /// gate accepts it. `out` is left empty when the step ends rejected.
   void deskewScan(OnlineStep& step, const PointArray& points, const PointTimes& times,
                   double interval, const Twist& placed, const Keyframe& keyframe,
                   const GateSettings& gate_settings, std::optional<PointArray>& out);
