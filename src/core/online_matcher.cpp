@@ -195,17 +195,19 @@ void OnlineMatcher::deskewScan(OnlineStep& step, const PointArray& points,
   const auto registered = [&](const Eigen::Isometry3d& increment) {
     return velocityOf(anchor * increment, interval);
   };
-  // The rigid registration of a bent sweep only starts the de-skew (a rigid result is a
-  // compromise between the sweep's lines, and the gate accepts most of them where they are
-  // wrong: BENCHMARK.md, "Sweeps taken while driving"); the first round's registration of the
-  // re-placed sweep is the verdict, accepted or not. A later round that is rejected keeps the
-  // round before it.
   const Eigen::Isometry3d predicted_increment = step.increment;
   const auto start = std::chrono::steady_clock::now();
-  for (int round = 0; round < settings_.deskew.iterations; ++round) {
+  const auto moved = [&](const Pose6& pose) {
+    const Eigen::Isometry3d change = step.increment.inverse() * poseToIsometry(pose);
+    return change.translation().norm() >= 1e-3 || Eigen::AngleAxisd(change.linear()).angle() >= 1.745e-4;
+  };
+  // Round 1: the pose at which every line lies on the reference (plane_polish.h), then a full
+  // registration of the sweep re-placed there. Its verdict is the scan's, accepted or not: the
+  // rigid registration of a bent sweep is a compromise between its lines that the gate accepts
+  // where it is wrong (BENCHMARK.md, "Sweeps taken while driving"), so it only starts this.
+  bool converged = false;  // round 1 moved the result less than 1 mm and 0.01 deg
+  if (settings_.deskew.iterations >= 1) {
     ++step.work.deskew_rounds;
-    // The pose at which every line lies on the reference (plane_polish.h), then a full
-    // registration of the sweep re-placed there: the result the gate judges.
     const SweepPolishResult sp = registration_.polishSweep(points, times.tau, interval, placed, anchor,
                                                            step.result.pose, 20);
     RegistrationResult again;
@@ -216,28 +218,52 @@ void OnlineMatcher::deskewScan(OnlineStep& step, const PointArray& points,
       again = registration_.align(*out, sp.pose);
       countAlign(step.work, again);
       reason = again.ok() ? gate(again, step.guess, gate_settings) : GateReason::BadInput;
+    } else {
+      appendMessage(step, "sweep polish not applied (" + sp.reason + ")");
     }
-    if (reason != GateReason::Accepted) {
-      if (round == 0) {
-        step.accepted = false;
-        step.reason = reason;
-        step.increment = predicted_increment;
-        if (again.ok()) step.result = std::move(again);
-        if (!sp.applied) appendMessage(step, "sweep polish not applied (" + sp.reason + ")");
+    step.accepted = reason == GateReason::Accepted;
+    step.reason = reason;
+    if (again.ok()) {
+      converged = !moved(again.pose);
+      step.result = std::move(again);
+      if (step.accepted) {
+        step.increment = step.result.transform;
+        step.correction = correctionFromGuess(step.guess, step.result.pose);
+        ++step.reregistered;
       }
-      break;
     }
-    const Eigen::Isometry3d change = step.increment.inverse() * again.transform;
-    step.result = std::move(again);
+  }
+  // Later rounds: the continuous-time polish again from the registered result (round 1's
+  // rigid polish of the re-placed sweep was bound to the motion the sweep was re-placed with).
+  // A polish that stays within the polish's shift limits is the round's result (the verdict,
+  // J and covariance stay round 1's); one that moves further means round 1 had not converged:
+  // the sweep re-placed there is registered again, kept if the gate accepts it.
+  const PolishSettings& limits = settings_.registration.polish;
+  for (int round = 1; step.accepted && !converged && round < settings_.deskew.iterations; ++round) {
+    ++step.work.deskew_rounds;
+    const SweepPolishResult sp = registration_.polishSweep(points, times.tau, interval, placed, anchor,
+                                                           step.result.pose, 20);
+    if (!sp.applied) break;
+    if (sp.shift_m <= limits.max_shift_m && sp.shift_rad <= limits.max_shift_rad) {
+      converged = !moved(sp.pose);
+      step.result.pose = sp.pose;
+      step.result.transform = poseToIsometry(sp.pose);
+    } else {
+      out = points;
+      deskew(*out, times.tau, placed, registered(poseToIsometry(sp.pose)));
+      RegistrationResult again = registration_.align(*out, sp.pose);
+      countAlign(step.work, again);
+      if (!again.ok() || gate(again, step.guess, gate_settings) != GateReason::Accepted) break;
+      converged = !moved(again.pose);
+      step.result = std::move(again);
+    }
     step.increment = step.result.transform;
     step.correction = correctionFromGuess(step.guess, step.result.pose);
-    step.accepted = true;
-    step.reason = GateReason::Accepted;
     ++step.reregistered;
-    if (change.translation().norm() < 1e-3 && Eigen::AngleAxisd(change.linear()).angle() < 1.745e-4) break;
   }
   step.work.deskew_s = secondsSince(start);
   if (!step.accepted) {
+    step.increment = predicted_increment;
     out.reset();  // a rejected scan is never a keyframe's points
     return;
   }

@@ -43,10 +43,12 @@ struct DeskewSettings {
   /// velocity since the last known scan. Only scans given with point times that differ (a
   /// sweep taken over time) are touched.
   bool enabled = true;
-  /// Rounds of polish + registration (each about one registration's time; it stops early
-  /// once a round moves the result less than 1 mm and 0.01 deg, or the gate rejects a later
-  /// round's result, which is then not used). 0: the rigid registration's verdict, the sweep
-  /// re-placed with its motion. In [0, 10].
+  /// Rounds: the first is the polish + a registration of the re-placed sweep (the verdict);
+  /// each further round runs the continuous-time polish again from the result (no
+  /// registration, unless the polish moves beyond the polish's max_shift_m / max_shift_rad:
+  /// then the sweep re-placed there is registered again, kept if the gate accepts it). It
+  /// stops once a round moves the result less than 1 mm and 0.01 deg. 0: the rigid
+  /// registration's verdict, the sweep re-placed with its motion. In [0, 10].
   int iterations = 2;
 };
 
@@ -264,9 +266,9 @@ class OnlineMatcher {
                    bool refused);
   static void describe(OnlineStep& step);
   /// De-skews a scan whose rigid registration found a pose with the registered motion over
-  /// `interval` [s] since last_known_ into `out`, and registers it again: the first round's
-  /// result is the step's verdict (accepted or rejected), a later round's is kept only if the
-  /// gate accepts it. `out` is left empty when the step ends rejected.
+  /// `interval` [s] since last_known_ into `out` (DeskewSettings::iterations rounds): the
+  /// first round's registration is the step's verdict (accepted or rejected). `out` is left
+  /// empty when the step ends rejected.
   void deskewScan(OnlineStep& step, const PointArray& points, const PointTimes& times,
                   double interval, const Twist& placed, const Keyframe& keyframe,
                   const GateSettings& gate_settings, std::optional<PointArray>& out);
