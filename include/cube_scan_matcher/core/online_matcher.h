@@ -146,7 +146,7 @@ struct OnlineStep {
   /// When deskewed: the scan's points re-placed (base frame at the stamp), one per input point
   /// in the same order; the keyframe holds the same.
   PointArray deskewed_points;
-  int reregistered = 0;            ///< de-skew rounds whose registration was kept (the result is the last's).
+  int reregistered = 0;            ///< de-skew rounds whose result was kept (the step's result is the last one's).
   int consecutive_rejections = 0;
   /// The gate's max_correction bounds were multiplied by this: the time since the reference
   /// in whole scan periods (the lower quartile of the last 16 intervals), in [1, 4], and at
