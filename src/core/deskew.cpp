@@ -52,6 +52,12 @@ Twist velocityOf(const Eigen::Isometry3d& motion, double interval) {
   return interval > 0.0 ? Twist(logMotion(motion) / interval) : Twist(Twist::Zero());
 }
 
+Twist SweepMotion::velocity(const Eigen::Isometry3d& T) const {
+  if (!odometry_shaped) return velocityOf(anchor * T, interval);
+  const Eigen::Isometry3d correction = odom_span.inverse() * (anchor * T);
+  return velocityOf(odom_own * expMotion(logMotion(correction) * (own / interval)), own);
+}
+
 void deskew(PointArray& points, const std::vector<float>& tau, const Twist& placed,
             const Twist& truth) {
   if (tau.size() != points.size()) {

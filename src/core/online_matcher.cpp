@@ -185,16 +185,12 @@ bool takenOverTime(const PointTimes* times) {
 }  // namespace
 
 void OnlineMatcher::deskewScan(OnlineStep& step, const PointArray& points,
-                               const PointTimes& times, double interval, const Twist& placed,
-                               const Keyframe& keyframe, const GateSettings& gate_settings,
+                               const PointTimes& times, const SweepMotion& motion,
+                               const Twist& placed, const GateSettings& gate_settings,
                                std::optional<PointArray>& out) {
-  // The velocity the points were placed with (`placed`), and the registered one: the motion
-  // since the last known scan, anchor * increment (anchor = T_known_keyframe), over `interval`
-  // (core/deskew.h).
-  const Eigen::Isometry3d anchor = last_known_->pose.inverse() * keyframe.pose;
-  const auto registered = [&](const Eigen::Isometry3d& increment) {
-    return velocityOf(anchor * increment, interval);
-  };
+  // The velocity the points were placed with (`placed`), and the registered one for an
+  // increment keyframe -> scan (`motion`, core/deskew.h).
+  const auto registered = [&](const Eigen::Isometry3d& increment) { return motion.velocity(increment); };
   const Eigen::Isometry3d predicted_increment = step.increment;
   const auto start = std::chrono::steady_clock::now();
   const auto moved = [&](const Pose6& pose) {
@@ -208,7 +204,7 @@ void OnlineMatcher::deskewScan(OnlineStep& step, const PointArray& points,
   bool converged = false;  // round 1 moved the result less than 1 mm and 0.01 deg
   if (settings_.deskew.iterations >= 1) {
     ++step.work.deskew_rounds;
-    const SweepPolishResult sp = registration_.polishSweep(points, times.tau, interval, placed, anchor,
+    const SweepPolishResult sp = registration_.polishSweep(points, times.tau, motion, placed,
                                                            step.result.pose, 20);
     RegistrationResult again;
     GateReason reason = GateReason::Uncertain;  // no polish: the sweep's motion is unknown
@@ -241,7 +237,7 @@ void OnlineMatcher::deskewScan(OnlineStep& step, const PointArray& points,
   const PolishSettings& limits = settings_.registration.polish;
   for (int round = 1; step.accepted && !converged && round < settings_.deskew.iterations; ++round) {
     ++step.work.deskew_rounds;
-    const SweepPolishResult sp = registration_.polishSweep(points, times.tau, interval, placed, anchor,
+    const SweepPolishResult sp = registration_.polishSweep(points, times.tau, motion, placed,
                                                            step.result.pose, 20);
     if (!sp.applied) break;
     if (sp.shift_m <= limits.max_shift_m && sp.shift_rad <= limits.max_shift_rad) {
@@ -285,6 +281,10 @@ OnlineStep OnlineMatcher::process(const PointArray& points, double stamp,
   const auto start = std::chrono::steady_clock::now();
   OnlineStep step;
   const std::optional<Eigen::Isometry3d> odom = usableOdometry(given_odom, step);
+  // Whether the scan before this one is the last known one (none rejected in between), and
+  // the odometry at the last scan that had one: the de-skew's motion model.
+  const bool follows_known = last_known_ && last_stamp_ && *last_stamp_ == last_known_->stamp;
+  const std::optional<Known> odom_before = previous_odom_;
   trackTime(stamp, step);
   const Twist placed = placedVelocity(stamp, odom, times);
   const bool first = keyframes_.empty();
@@ -302,8 +302,18 @@ OnlineStep OnlineMatcher::process(const PointArray& points, double stamp,
     // one the gate rejected: the de-skewed registration decides.
     if (step.result.ok() && takenOverTime(times) && settings_.deskew.enabled && last_known_ &&
         stamp > last_known_->stamp) {
-      deskewScan(step, points, *times, stamp - last_known_->stamp, placed, *keyframe,
-                 scaledGate(step.gate_scale), deskewed);
+      SweepMotion motion;
+      motion.anchor = last_known_->pose.inverse() * keyframe->pose;
+      motion.interval = stamp - last_known_->stamp;
+      if (!follows_known && odom && last_known_->odom && odom_before &&
+          odom_before->stamp > last_known_->stamp && stamp > odom_before->stamp) {
+        // Scans between were rejected: the odometry's shape of the motion since the known scan.
+        motion.odometry_shaped = true;
+        motion.odom_span = last_known_->odom->inverse() * *odom;
+        motion.odom_own = odom_before->odom->inverse() * *odom;
+        motion.own = stamp - odom_before->stamp;
+      }
+      deskewScan(step, points, *times, motion, placed, scaledGate(step.gate_scale), deskewed);
     }
   }
   const bool refused = !placeScan(step, keyframe, predicted.pose);

@@ -504,9 +504,10 @@ PolishResult polishOnPlanes(const PlaneMap& map, const PointArray& scan, const P
 }
 
 SweepPolishResult polishSweepOnPlanes(const PlaneMap& map, const PointArray& scan,
-                                      const std::vector<float>& tau, double interval,
-                                      const Twist& placed, const Eigen::Isometry3d& anchor,
-                                      const Pose6& pose, const PolishSettings& s, int max_iterations) {
+                                      const std::vector<float>& tau, const SweepMotion& motion,
+                                      const Twist& placed, const Pose6& pose,
+                                      const PolishSettings& s, int max_iterations) {
+  const double interval = motion.interval;
   SweepPolishResult res;
   res.pose = pose;
   if (scan.empty() || map.voxels() == 0 || !pose.allFinite() || tau.size() != scan.size() ||
@@ -529,7 +530,7 @@ SweepPolishResult polishSweepOnPlanes(const PlaneMap& map, const PointArray& sca
   std::vector<float> near_weight, near_tau;
   PointArray near_raw;
   for (int it = 0; it < max_iterations; ++it) {
-    const Twist velocity = velocityOf(anchor * T, interval);  // of T_known_this
+    const Twist velocity = motion.velocity(T);
     Linearisation L;
     if (it == 0) {
       placed_now = scan;

@@ -271,12 +271,11 @@ std::size_t CubeRegistration::workspaceBytes() const {
 }
 
 SweepPolishResult CubeRegistration::polishSweep(const PointArray& scan, const std::vector<float>& tau,
-                                                double interval, const Twist& placed,
-                                                const Eigen::Isometry3d& anchor, const Pose6& pose,
-                                                int max_iterations) const {
+                                                const SweepMotion& motion, const Twist& placed,
+                                                const Pose6& pose, int max_iterations) const {
   std::lock_guard<std::mutex> lock(*mutex_);
   if (!reference_) throw std::logic_error("CubeRegistration::polishSweep before setReference");
-  return polishSweepOnPlanes(reference_->planes, scan, tau, interval, placed, anchor, pose,
+  return polishSweepOnPlanes(reference_->planes, scan, tau, motion, placed, pose,
                              settings_.polish, max_iterations);
 }
 

@@ -34,6 +34,27 @@ Eigen::Isometry3d motionAt(const Twist& xi, double tau, double interval);
 /// (zero for interval <= 0).
 Twist velocityOf(const Eigen::Isometry3d& motion, double interval);
 
+/// The motion a registered pose implies over a sweep's own interval. The sweep's pose T
+/// (scan -> reference) and the last known scan's pose (anchor = T_known_reference) span
+/// `interval` [s]. When the known scan is the previous one, the sweep moved at the constant
+/// velocity log(anchor T) / interval. When scans between were rejected (their poses are
+/// predictions), one constant velocity over the whole span would lose the motion's shape (a
+/// turn that reverses within it). With the odometry's motion over the span (`odom_span`) and
+/// over the sweep's own interval `own` [s] (`odom_own`), the odometry's error over the span,
+/// C = odom_span^-1 anchor T, is spread over the span at a constant rate, and the sweep's motion
+/// is odom_own exp(own / interval log C): the odometry's shape, corrected.
+struct SweepMotion {
+  Eigen::Isometry3d anchor = Eigen::Isometry3d::Identity();
+  double interval = 0.0;         ///< [s] from the known scan to the sweep's stamp
+  bool odometry_shaped = false;  ///< odom_span, odom_own and own are set
+  Eigen::Isometry3d odom_span = Eigen::Isometry3d::Identity();
+  Eigen::Isometry3d odom_own = Eigen::Isometry3d::Identity();
+  double own = 0.0;  ///< [s] the sweep's own interval (since the previous scan)
+
+  /// The sweep's velocity [twist per second] for its registered pose T.
+  Twist velocity(const Eigen::Isometry3d& T) const;
+};
+
 /// Re-places `points` (base frame at the reference time) with time offsets `tau` [s] (same
 /// size, relative to the reference time), placed with velocity `placed`, with velocity `truth`
 /// instead (equation above). Points with equal tau share one transform (a 2D line's). Throws

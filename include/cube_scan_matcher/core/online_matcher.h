@@ -40,8 +40,9 @@ struct DeskewSettings {
   /// registered motion (instead of the odometry's, or none) as the keyframe. The gate's verdict
   /// on the first round's registration is the scan's: the rigid registration of a bent sweep
   /// is a compromise between its lines, often wrong where the gate cannot tell. Constant
-  /// velocity since the last known scan. Only scans given with point times that differ (a
-  /// sweep taken over time) are touched.
+  /// velocity since the last known scan; after rejected scans, the odometry's motion with its
+  /// error since the known scan spread evenly (core/deskew.h SweepMotion). Only scans given
+  /// with point times that differ (a sweep taken over time) are touched.
   bool enabled = true;
   /// Rounds: the first is the polish + a registration of the re-placed sweep (the verdict);
   /// each further round runs the continuous-time polish again from the result (no
@@ -265,12 +266,12 @@ class OnlineMatcher {
                    const std::optional<Eigen::Isometry3d>& odom, const Keyframe* keyframe,
                    bool refused);
   static void describe(OnlineStep& step);
-  /// De-skews a scan whose rigid registration found a pose with the registered motion over
-  /// `interval` [s] since last_known_ into `out` (DeskewSettings::iterations rounds): the
-  /// first round's registration is the step's verdict (accepted or rejected). `out` is left
-  /// empty when the step ends rejected.
+  /// De-skews a scan whose rigid registration found a pose with the registered motion
+  /// (`motion`: since last_known_) into `out` (DeskewSettings::iterations rounds): the first
+  /// round's registration is the step's verdict (accepted or rejected). `out` is left empty
+  /// when the step ends rejected.
   void deskewScan(OnlineStep& step, const PointArray& points, const PointTimes& times,
-                  double interval, const Twist& placed, const Keyframe& keyframe,
+                  const SweepMotion& motion, const Twist& placed,
                   const GateSettings& gate_settings, std::optional<PointArray>& out);
   OnlineMatcherSettings settings_;
   CubeRegistration registration_;

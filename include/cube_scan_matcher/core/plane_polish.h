@@ -153,15 +153,14 @@ struct SweepPolishResult {
 
 /// Polishes `pose` (scan -> reference, eq. 2) of a sweep whose points were placed with the
 /// velocity `placed` (core/deskew.h; zero for a rigid sweep) and taken at times `tau` [s]
-/// relative to the scan's stamp, `interval` [s] after the last scan whose pose is known: every
-/// Gauss-Newton step re-places the points with the velocity the pose implies,
-/// log(anchor * pose) / interval (anchor = T_known_reference), so that the result is the pose
+/// relative to the scan's stamp: every Gauss-Newton step re-places the points with the
+/// velocity the pose implies (`motion`, core/deskew.h: since the last scan whose pose is
+/// known, `motion.interval` [s] before the stamp), so that the result is the pose
 /// at which every line of the sweep lies on the reference's planes, not a compromise between
 /// the lines. At most max_iterations steps; stops at the settings' tolerances.
 SweepPolishResult polishSweepOnPlanes(const PlaneMap& map, const PointArray& scan,
-                                      const std::vector<float>& tau, double interval,
-                                      const Twist& placed, const Eigen::Isometry3d& anchor,
-                                      const Pose6& pose, const PolishSettings& settings,
-                                      int max_iterations);
+                                      const std::vector<float>& tau, const SweepMotion& motion,
+                                      const Twist& placed, const Pose6& pose,
+                                      const PolishSettings& settings, int max_iterations);
 
 }  // namespace cube_scan_matcher

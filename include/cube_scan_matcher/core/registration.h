@@ -196,8 +196,7 @@ class CubeRegistration {
   /// polishSweepOnPlanes() on the reference's planes with the polish settings.
   /// Needs a reference with planes (else not applied, with the reason).
   SweepPolishResult polishSweep(const PointArray& scan, const std::vector<float>& tau,
-                                double interval, const Twist& placed,
-                                const Eigen::Isometry3d& anchor, const Pose6& pose,
+                                const SweepMotion& motion, const Twist& placed, const Pose6& pose,
                                 int max_iterations) const;
 
   const RegistrationSettings& settings() const { return settings_; }
