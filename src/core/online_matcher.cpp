@@ -189,8 +189,15 @@ void OnlineMatcher::deskewScan(OnlineStep& step, const PointArray& points,
                                const Twist& placed, const GateSettings& gate_settings,
                                std::optional<PointArray>& out) {
   // The velocity the points were placed with (`placed`), and the registered one for an
-  // increment keyframe -> scan (`motion`, core/deskew.h).
-  const auto registered = [&](const Eigen::Isometry3d& increment) { return motion.velocity(increment); };
+  // increment keyframe -> scan (`motion`, core/deskew.h). The sweep re-placed with the motion
+  // of `pose` (into `out`) and registered from there:
+  const auto registerReplaced = [&](const Pose6& pose) {
+    out = points;
+    deskew(*out, times.tau, placed, motion.velocity(poseToIsometry(pose)));
+    RegistrationResult result = registration_.align(*out, pose);
+    countAlign(step.work, result);
+    return result;
+  };
   const Eigen::Isometry3d predicted_increment = step.increment;
   const auto start = std::chrono::steady_clock::now();
   const auto moved = [&](const Pose6& pose) {
@@ -209,10 +216,7 @@ void OnlineMatcher::deskewScan(OnlineStep& step, const PointArray& points,
     RegistrationResult again;
     GateReason reason = GateReason::Uncertain;  // no polish: the sweep's motion is unknown
     if (sp.applied) {
-      out = points;
-      deskew(*out, times.tau, placed, registered(poseToIsometry(sp.pose)));
-      again = registration_.align(*out, sp.pose);
-      countAlign(step.work, again);
+      again = registerReplaced(sp.pose);
       reason = again.ok() ? gate(again, step.guess, gate_settings) : GateReason::BadInput;
     } else {
       appendMessage(step, "sweep polish not applied (" + sp.reason + ")");
@@ -245,10 +249,7 @@ void OnlineMatcher::deskewScan(OnlineStep& step, const PointArray& points,
       step.result.pose = sp.pose;
       step.result.transform = poseToIsometry(sp.pose);
     } else {
-      out = points;
-      deskew(*out, times.tau, placed, registered(poseToIsometry(sp.pose)));
-      RegistrationResult again = registration_.align(*out, sp.pose);
-      countAlign(step.work, again);
+      RegistrationResult again = registerReplaced(sp.pose);
       if (!again.ok() || gate(again, step.guess, gate_settings) != GateReason::Accepted) break;
       converged = !moved(again.pose);
       step.result = std::move(again);
@@ -265,7 +266,7 @@ void OnlineMatcher::deskewScan(OnlineStep& step, const PointArray& points,
   }
   // The keyframe's points: re-placed with the final motion (from the scan as given).
   out = points;
-  deskew(*out, times.tau, placed, registered(step.increment));
+  deskew(*out, times.tau, placed, motion.velocity(step.increment));
   step.deskewed = true;
 }
 

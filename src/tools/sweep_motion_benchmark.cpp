@@ -92,7 +92,6 @@ struct Row {
   double es_reg, ea_reg;
   std::string reason;
   bool success() const { return es < 0.10 && ea < 1.0; }
-  bool registrationRight() const { return es_reg < 0.10 && ea_reg < 1.0; }
 };
 
 /// The sweeps of one run: moving (in base_link at the reference time, placed by odometry, with
