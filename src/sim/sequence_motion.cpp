@@ -15,6 +15,14 @@ SequenceMotion::SequenceMotion(const Scene& scene, const SequenceSettings& setti
   place();
 }
 
+bool SequenceMotion::clear(double x, double y) const {
+  const double ground = scene_.groundHeight(x, y);
+  for (const double h : {0.2, 0.6, s_.height}) {
+    if (scene_.insideSolid(Eigen::Vector3d(x, y, ground + h), s_.clearance)) return false;
+  }
+  return true;
+}
+
 void SequenceMotion::place() { pose_ = placeOnGround(scene_, x_, y_, heading_, s_.height); }
 
 void SequenceMotion::advance() {
@@ -38,9 +46,22 @@ void SequenceMotion::advance() {
       rel = std::clamp(rel, -hmax, hmax);
       const double side = axis_ == 0.0 ? 1.0 : -1.0;  // +y is left when driving along +x
       if (std::abs(y_) > s_.lateral_limit) rel = (y_ * side > 0 ? -1.0 : 1.0) * std::abs(rel);
-      heading_ = wrapAngle(axis_ + rel);
-      x_ += s_.step * std::cos(heading_);
-      y_ += s_.step * std::sin(heading_);
+      // The first heading from the planned one (then 10, 20, ... 60 deg to either side) whose
+      // step ends clear of every solid; none: turn round here.
+      bool moved = false;
+      for (int k = 0; k <= 12 && !moved; ++k) {
+        const double offset = deg2rad(10.0 * double((k + 1) / 2)) * (k % 2 == 0 ? -1.0 : 1.0);
+        const double h = wrapAngle(axis_ + rel + offset);
+        const double x = x_ + s_.step * std::cos(h), y = y_ + s_.step * std::sin(h);
+        if (!clear(x, y)) continue;
+        heading_ = h, x_ = x, y_ = y;
+        moved = true;
+      }
+      if (!moved) {
+        next(Phase::TurnRound, 2 * quarter);
+        axis_ = axis_ == 0.0 ? M_PI : 0.0;
+        return advance();
+      }
       break;
     }
     case Phase::Stand:

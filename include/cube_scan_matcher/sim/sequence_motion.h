@@ -1,6 +1,7 @@
 // A long simulated run for the sequence benchmark: the robot drives up and down the scene's
 // street one sweep at a time, stops now and then to stand still and to look around (a 90 deg
-// turn on the spot and back), and turns round on the spot at the street's ends. Its pose
+// turn on the spot and back), and turns round on the spot at the street's ends (or where an
+// object blocks the way). It keeps clear of solids by its radius. Its pose
 // follows the ground (height, and pitch and roll from the terrain's slope).
 #pragma once
 
@@ -23,6 +24,10 @@ struct SequenceSettings {
   double lateral_limit = 1.5;     ///< [m] beyond |y| of this the robot steers back.
   double x_min = -5.0, x_max = 125.0;  ///< [m] turn round on the spot beyond these.
   double height = 1.0;            ///< [m] base_link above the ground.
+  /// [m] the robot's radius: a driving sweep never ends closer than this to a solid (checked
+  /// 0.2 m, 0.6 m and `height` above the ground). A step that would come closer turns up to 60 deg
+  /// off its heading, else the robot turns round where it is.
+  double clearance = 0.3;
 };
 
 class SequenceMotion {
@@ -36,6 +41,8 @@ class SequenceMotion {
  private:
   enum class Phase { Drive, Stand, LookOut, LookBack, TurnRound };
   void place();
+  /// Whether the robot fits at (x, y): no solid within `clearance` of its body.
+  bool clear(double x, double y) const;
   const Scene& scene_;
   SequenceSettings s_;
   std::mt19937_64 rng_;
