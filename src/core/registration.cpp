@@ -520,18 +520,13 @@ RegistrationResult CubeRegistration::align(const PointArray& scan, const Pose6& 
   // first attempt's other coarse results, one at a time (untried: those apart from the ones
   // tried; a scan turned on the spot, where the coarse stage or the refine ranks the truth
   // below a submap keyframe's own pose), then by a new coarse search; an ambiguous result by a
-  // new coarse search (a consensus needs an independent search). An ambiguous result that no
-  // search contradicts (no other ambiguous result elsewhere; the others unconfirmed) is searched
-  // for a consensus up to `retries` more times; one found elsewhere ends that, and the first
-  // stays the candidate.
+  // new coarse search (a consensus needs an independent search).
   std::vector<Pose6> ranked0;
   std::vector<int> ranked0_J, untried;
   const bool from_ranked = ss.grid.enabled() && ss.retries > 0;
-  int searches = 0;  // coarse searches run: at most 1 + retries (+ retries for a consensus)
+  int searches = 0;  // coarse searches run: at most 1 + retries
   bool previous_ambiguous = false;
-  bool rival = false;  // two ambiguous results apart
   for (int attempt = 0;; ++attempt) {
-    const int allowed = ss.retries + (candidate && !rival ? ss.retries : 0);
     RegistrationResult r = before;
     std::vector<Pose6> r_ranked = ranked0;
     std::vector<int> r_ranked_J = ranked0_J;
@@ -539,7 +534,7 @@ RegistrationResult CubeRegistration::align(const PointArray& scan, const Pose6& 
     if (attempt > 0 && from_ranked && !previous_ambiguous && !untried.empty()) {
       from = untried.front();
       untried.erase(untried.begin());
-    } else if (attempt > 0 && searches > allowed) {
+    } else if (attempt > 0 && searches > ss.retries) {
       break;
     }
     if (from < 0) ++searches;
@@ -572,8 +567,7 @@ RegistrationResult CubeRegistration::align(const PointArray& scan, const Pose6& 
       res.consensus = true, done = true;
       break;
     }
-    if (candidate) rival = true;
-    if (!candidate || (r.J > candidate->J && searches <= ss.retries + 1)) candidate = r;
+    if (!candidate || r.J > candidate->J) candidate = r;
   }
   if (!done && candidate) {
     res = *candidate;

@@ -27,9 +27,7 @@ struct SearchSettings {
   /// from big starts are, a hall slid along its aisle), the search (coarse, refine, polish)
   /// runs again from new seeds (gnmm.seed + starts * attempt + k), up to `retries` more times;
   /// the first confirmed result wins (an ambiguous one only once a retry lands on it again:
-  /// ambiguous_weak_ratio; while no search found another ambiguous result elsewhere, up to
-  /// `retries` further searches look for that consensus), else the first one. No retry
-  /// without the polish (the
+  /// ambiguous_weak_ratio), else the first one. No retry without the polish (the
   /// paper's mode) or when the first result is confirmed. A scene that is degenerate
   /// (a tunnel) pays every retry. With the planar grid (`grid`) the seeds do not change
   /// between searches: a result that is not confirmed is first refined and polished again
@@ -52,9 +50,7 @@ struct SearchSettings {
   /// most ambiguous_max_agreeing of the starts' coarse results lie near it (the others found
   /// other maxima). It counts only when a retry lands on the same pose (within 5 cm and
   /// 0.5 deg: a consensus); else the result is marked ambiguous (RegistrationResult::ambiguous,
-  /// rejected by the gate). When no search found an ambiguous result elsewhere (the others
-  /// unconfirmed), up to `retries` more searches look for the consensus. 0 = off. In [0, 1]
-  /// and [0, 64].
+  /// rejected by the gate). 0 = off. In [0, 1] and [0, 64].
   double ambiguous_weak_ratio = 0.03;
   int ambiguous_max_agreeing = 1;
   /// Beyond the paper: before the starts, J on the coarse points over a grid of planar motions
