@@ -49,13 +49,14 @@ void SequenceMotion::advance() {
       // The first heading from the planned one (then 10, 20, ... 60 deg to either side) whose
       // step ends clear of every solid; none: turn round here.
       bool moved = false;
-      for (int k = 0; k <= 12 && !moved; ++k) {
+      for (int k = 0; k <= 12; ++k) {
         const double offset = deg2rad(10.0 * double((k + 1) / 2)) * (k % 2 == 0 ? -1.0 : 1.0);
         const double h = wrapAngle(axis_ + rel + offset);
         const double x = x_ + s_.step * std::cos(h), y = y_ + s_.step * std::sin(h);
         if (!clear(x, y)) continue;
         heading_ = h, x_ = x, y_ = y;
         moved = true;
+        break;
       }
       if (!moved) {
         next(Phase::TurnRound, 2 * quarter);

@@ -204,8 +204,8 @@ TEST(SimMotion, DrivenPathZigzagsAboutItsAxisOnTheGround) {
 
 TEST(SimMotion, SequenceRunKeepsTheRobotClearOfSolids) {
   // The sequence benchmark's 500 m runs: no sweep is taken where the robot's body would be
-  // inside an object (the urban world's street end has an object that a turn-round on the
-  // spot 0.25 m from it would have the scanner face from 0.1 m).
+  // inside an object (a turn on the spot 0.25 m from one has the scanner face it from 0.1 m,
+  // seeing nothing else), and the runs still turn on the spot.
   for (const sim::SceneType type : {sim::SceneType::Hall, sim::SceneType::Urban,
                                     sim::SceneType::Park, sim::SceneType::Natural}) {
     const sim::Scene scene = sim::Scene::generate(type, 1);
