@@ -575,7 +575,10 @@ def sweeps(out):
             es.append(statistics.median(float(r["Es_m"]) for r in st))
             ea.append(statistics.median(float(r["Ea_deg"]) for r in st))
             t.append(statistics.median(float(r["time_s"]) for r in st))
-        wrong = sum(r["accepted"] == "1" and r["success"] != "1" for r in sel)
+        # Accepted wrong: the registration itself off (Es_reg / Ea_reg, against the last
+        # accepted scan), not an increment that carries a rejected sweep's predicted pose.
+        wrong = sum(r["accepted"] == "1" and not (float(r["Es_reg_m"]) < 0.10
+                                                  and float(r["Ea_reg_deg"]) < 1.0) for r in sel)
         print("| %s | %s | %d/%d | %d/%d | %s cm / %s° | %s s |" % (
             odometry, mode, sum(r["success"] == "1" for r in steady), len(steady), wrong, len(sel),
             span([100 * e for e in es], "%.2f"), span(ea, "%.3f"), span(t, "%.2f")))

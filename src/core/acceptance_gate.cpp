@@ -23,6 +23,7 @@ std::string toString(GateReason reason) {
     case GateReason::Uncertain: return "uncertain";
     case GateReason::Ambiguous: return "ambiguous";
     case GateReason::NonFinite: return "non_finite";
+    case GateReason::BentSweep: return "bent_sweep";
   }
   return "unknown";
 }

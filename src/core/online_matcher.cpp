@@ -60,6 +60,10 @@ void validate(const OnlineMatcherSettings& s) {
   widest.half_yaw = widest.half_yaw > 0.0 ? double(EIGEN_PI) : 0.0;
   validate(widest);
   requireInRange("deskew iterations", s.deskew.iterations, 0, 10);
+  if (s.deskew.max_rms_ratio != 0.0) {
+    requireInRange("deskew max_rms_ratio", s.deskew.max_rms_ratio, 1.0, 100.0);
+  }
+  requireInRange("deskew min_plane_fraction_ratio", s.deskew.min_plane_fraction_ratio, 0.0, 1.0);
 }
 
 OnlineMatcher::OnlineMatcher(const OnlineMatcherSettings& settings)
@@ -77,6 +81,7 @@ void OnlineMatcher::reset() {
   anchor_.reset();
   last_stamp_.reset();
   intervals_.clear();
+  recent_fits_.clear();
   consecutive_rejections_ = 0;
   start_pose_.reset();
 }
@@ -187,7 +192,7 @@ bool takenOverTime(const PointTimes* times) {
 void OnlineMatcher::deskewScan(OnlineStep& step, const PointArray& points,
                                const PointTimes& times, const SweepMotion& motion,
                                const Twist& placed, const GateSettings& gate_settings,
-                               std::optional<PointArray>& out) {
+                               bool after_rejection, std::optional<PointArray>& out) {
   // The velocity the points were placed with (`placed`), and the registered one for an
   // increment keyframe -> scan (`motion`, core/deskew.h). The sweep re-placed with the motion
   // of `pose` (into `out`) and registered from there:
@@ -258,6 +263,14 @@ void OnlineMatcher::deskewScan(OnlineStep& step, const PointArray& points,
     step.correction = correctionFromGuess(step.guess, step.result.pose);
     ++step.reregistered;
   }
+  if (step.accepted && after_rejection) {
+    const std::string bent = bentSweep(step.result);
+    if (!bent.empty()) {
+      step.accepted = false;
+      step.reason = GateReason::BentSweep;
+      appendMessage(step, bent);
+    }
+  }
   step.work.deskew_s = secondsSince(start);
   if (!step.accepted) {
     step.increment = predicted_increment;
@@ -270,6 +283,30 @@ void OnlineMatcher::deskewScan(OnlineStep& step, const PointArray& points,
   step.deskewed = true;
 }
 
+std::string OnlineMatcher::bentSweep(const RegistrationResult& r) const {
+  if (recent_fits_.empty() || !r.polished || r.points_used == 0) return {};
+  const auto median = [&](double PlaneFit::*field) {
+    std::vector<double> v;
+    for (const PlaneFit& f : recent_fits_) v.push_back(f.*field);
+    std::nth_element(v.begin(), v.begin() + std::ptrdiff_t(v.size() / 2), v.end());
+    return v[v.size() / 2];
+  };
+  const DeskewSettings& d = settings_.deskew;
+  std::ostringstream os;
+  os.precision(3);
+  const double fraction = double(r.plane_correspondences) / double(r.points_used);
+  if (d.max_rms_ratio > 0.0 && r.plane_rms > d.max_rms_ratio * median(&PlaneFit::rms)) {
+    os << "plane RMS " << 100.0 * r.plane_rms << " cm > " << d.max_rms_ratio << " x the recent "
+       << 100.0 * median(&PlaneFit::rms) << " cm";
+  } else if (fraction < d.min_plane_fraction_ratio * median(&PlaneFit::fraction)) {
+    os << "points on planes " << fraction << " < " << d.min_plane_fraction_ratio
+       << " x the recent " << median(&PlaneFit::fraction);
+  } else {
+    return {};
+  }
+  os << " after rejected scans: the sweep is still bent by a motion nothing registered";
+  return os.str();
+}
 
 OnlineStep OnlineMatcher::process(const PointArray& points, double stamp,
                                   const std::optional<Eigen::Isometry3d>& given_odom,
@@ -314,10 +351,16 @@ OnlineStep OnlineMatcher::process(const PointArray& points, double stamp,
         motion.odom_own = odom_before->odom->inverse() * *odom;
         motion.own = stamp - odom_before->stamp;
       }
-      deskewScan(step, points, *times, motion, placed, scaledGate(step.gate_scale), deskewed);
+      deskewScan(step, points, *times, motion, placed, scaledGate(step.gate_scale), !follows_known,
+                 deskewed);
     }
   }
   const bool refused = !placeScan(step, keyframe, predicted.pose);
+  if (step.accepted && step.result.polished && step.result.points_used > 0) {
+    recent_fits_.push_back({step.result.plane_rms, double(step.result.plane_correspondences) /
+                                                       double(step.result.points_used)});
+    if (recent_fits_.size() > kRecentFits) recent_fits_.pop_front();
+  }
   countRejections(step, keyframe);
   updateChain(step, deskewed ? *deskewed : points, stamp, odom, keyframe, refused);
   if (deskewed) step.deskewed_points = std::move(*deskewed);

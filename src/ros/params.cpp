@@ -70,6 +70,8 @@ void configToSettings(const ScanMatcherConfig& c, OnlineMatcherSettings& m) {
   m.no_motion_dense_points = c.no_motion_dense_points;
   m.deskew.enabled = c.deskew;
   m.deskew.iterations = c.deskew_iterations;
+  m.deskew.max_rms_ratio = c.bent_sweep_rms_ratio;
+  m.deskew.min_plane_fraction_ratio = c.bent_sweep_fraction_ratio;
 }
 
 /// The unit in a cfg description ("Cube edge E [m] (paper ...)" -> "m"), or "".
@@ -158,6 +160,8 @@ ScanMatcherConfig toConfig(const NodeParams& p) {
   c.no_motion_dense_points = p.matcher.no_motion_dense_points;
   c.deskew = p.matcher.deskew.enabled;
   c.deskew_iterations = p.matcher.deskew.iterations;
+  c.bent_sweep_rms_ratio = p.matcher.deskew.max_rms_ratio;
+  c.bent_sweep_fraction_ratio = p.matcher.deskew.min_plane_fraction_ratio;
   return c;
 }
 

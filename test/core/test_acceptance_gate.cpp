@@ -101,6 +101,7 @@ TEST(AcceptanceGate, RejectsAnAmbiguousResult) {
   g.reject_ambiguous = false;
   EXPECT_EQ(gate(r, guess, g), GateReason::Accepted);
   EXPECT_EQ(toString(GateReason::Ambiguous), "ambiguous");
+  EXPECT_EQ(toString(GateReason::BentSweep), "bent_sweep");
 }
 
 // A polished result whose translation standard deviation (along any direction) exceeds

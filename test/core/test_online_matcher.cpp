@@ -589,3 +589,76 @@ TEST(OnlineMatcher, NoOdometryGridAndDensePointsAreValidatedByName) {
   s.no_odometry_grid = PlanarGridSettings{};  // off is a valid setting
   EXPECT_NO_THROW(OnlineMatcher{s});
 }
+
+namespace {
+
+/// The step of a sweep taken after a rejected scan: a run driven at 1 m/s and 20 deg/s with
+/// 2 s sweeps in urban world 1, started standing still; sweep 1 with the true odometry; scan 2
+/// lost (empty: a rejection); sweep 3 with the true odometry at its end but with the odometry
+/// at scan 2 off by `lost_odometry_error` (a yaw [deg] about the vertical), so that the motion
+/// inside sweep 3 (odometry at 2 to odometry at 3) is bent by as much and nothing registered
+/// corrects it. `increment_error`: sweep 3's pose error against sweep 1 [m], [deg].
+OnlineStep sweepAfterARejection(bool check, double lost_odometry_error_deg,
+                                std::pair<double, double>& increment_error) {
+  const sim::Scene scene = sim::Scene::generate(sim::SceneType::Urban, 1);
+  const double d = 2.0;
+  const sim::DrivenPath path(scene, {1.0, 20.0, d, 1.0}, 30.0, 0.0, 0.0);
+  Eigen::Isometry3d mount = Eigen::Isometry3d::Identity();
+  mount.linear() = sim::sensorToBodyRotation();
+  std::mt19937_64 rng(5);
+  OnlineMatcherSettings s;
+  if (!check) s.deskew.max_rms_ratio = s.deskew.min_plane_fraction_ratio = 0.0;
+  OnlineMatcher m(s);
+  m.process(sim::scanInBody(scene, sim::ScannerModel{}, path.at(0.0), rng), 0.0, path.at(0.0));
+  const auto sweepAt = [&](int k, const Eigen::Isometry3d& placed_increment) {
+    const sim::TimedSweep sweep = sim::scanDuringMotion(
+        scene, sim::ScannerModel{}, [&](double t) { return path.at(t) * mount; }, k * d, d,
+        k % 2 == 1, rng);
+    return std::make_pair(sim::placeSweep(sweep, mount, placed_increment, d), sweep.time);
+  };
+  const auto [first, first_tau] = sweepAt(1, path.at(0.0).inverse() * path.at(d));
+  const PointTimes first_times{first_tau, true};
+  const OnlineStep one = m.process(first, d, path.at(d), &first_times);
+  EXPECT_TRUE(one.accepted) << one.message;
+  Eigen::Isometry3d lost_odom = path.at(2 * d);
+  lost_odom.linear() = lost_odom.linear() *
+      Eigen::AngleAxisd(deg2rad(lost_odometry_error_deg), Eigen::Vector3d::UnitZ()).toRotationMatrix();
+  const OnlineStep two = m.process(PointArray{}, 2 * d, lost_odom);
+  EXPECT_EQ(two.reason, GateReason::BadInput);
+  const auto [third, third_tau] = sweepAt(3, lost_odom.inverse() * path.at(3 * d));
+  const PointTimes third_times{third_tau, true};
+  const OnlineStep three = m.process(third, 3 * d, path.at(3 * d), &third_times);
+  const Eigen::Isometry3d estimate = one.pose.inverse() * three.pose;
+  const Eigen::Isometry3d truth = path.at(d).inverse() * path.at(3 * d);
+  increment_error = {translationError(estimate, truth),
+                     rad2deg(Eigen::AngleAxisd(estimate.linear() * truth.linear().transpose()).angle())};
+  std::printf("[bent sweep] check %s, odometry at the lost scan off %.0f deg: %s; plane RMS "
+              "%.2f cm (sweep 1 %.2f cm); fraction on planes %.3f (sweep 1 %.3f); %.3f m, %.2f deg off\n", check ? "on" : "off", lost_odometry_error_deg,
+              toString(three.reason).c_str(), 100.0 * three.result.plane_rms, 100.0 * one.result.plane_rms,
+              double(three.result.plane_correspondences) / three.result.points_used,
+              double(one.result.plane_correspondences) / one.result.points_used,
+              increment_error.first, increment_error.second);
+  return three;
+}
+
+}  // namespace
+
+TEST(OnlineMatcher, ASweepStillBentAfterARejectionIsRejected) {
+  std::pair<double, double> error;
+  // The odometry right at the lost scan: the sweep's motion is right, the sweep accepted.
+  const OnlineStep straight = sweepAfterARejection(true, 0.0, error);
+  EXPECT_TRUE(straight.accepted) << straight.message;
+  EXPECT_LT(error.first, 0.02);
+  EXPECT_LT(error.second, 0.1);
+  // Off by 8 deg there (the "big" odometry's bound): the sweep stays bent by as much, its
+  // residual on the reference's planes shows it, and it is rejected, not made a keyframe.
+  const OnlineStep bent = sweepAfterARejection(true, 8.0, error);
+  EXPECT_EQ(bent.reason, GateReason::BentSweep) << bent.message;
+  EXPECT_FALSE(bent.accepted);
+  EXPECT_FALSE(bent.reference_updated);
+  EXPECT_TRUE(bent.deskewed_points.empty());
+  // Without the check the same sweep is accepted wrong.
+  const OnlineStep unchecked = sweepAfterARejection(false, 8.0, error);
+  EXPECT_TRUE(unchecked.accepted) << unchecked.message;
+  EXPECT_TRUE(error.first > 0.10 || error.second > 1.0);
+}

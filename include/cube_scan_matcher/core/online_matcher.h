@@ -51,6 +51,18 @@ struct DeskewSettings {
   /// stops once a round moves the result less than 1 mm and 0.01 deg. 0: the rigid
   /// registration's verdict, the sweep re-placed with its motion. In [0, 10].
   int iterations = 2;
+  /// After rejected scans the sweep's own motion is not registered (the odometry's, or a
+  /// constant velocity over the span), and a sweep still bent by it can be registered wrong
+  /// where the gate accepts it. Its fit to the reference's planes shows the bend: the lines
+  /// that do not fit leave the polish's kernel (fewer points on planes), those near it fit
+  /// worse (a higher residual). Such a sweep is rejected (GateReason::BentSweep) when its
+  /// registration's plane RMS exceeds max_rms_ratio times, or its fraction of points on
+  /// planes (RegistrationResult::plane_correspondences / points_used) falls below
+  /// min_plane_fraction_ratio times, the median of the last accepted results' (BENCHMARK.md,
+  /// "Sweeps taken while driving"). 0 = off; else max_rms_ratio in [1, 100],
+  /// min_plane_fraction_ratio in (0, 1].
+  double max_rms_ratio = 1.6;
+  double min_plane_fraction_ratio = 0.9;
 };
 
 /// The per-point times of a scan taken over time (a tilting scanner's sweep, a spinning
@@ -272,7 +284,8 @@ class OnlineMatcher {
   /// when the step ends rejected.
   void deskewScan(OnlineStep& step, const PointArray& points, const PointTimes& times,
                   const SweepMotion& motion, const Twist& placed,
-                  const GateSettings& gate_settings, std::optional<PointArray>& out);
+                  const GateSettings& gate_settings, bool after_rejection,
+                  std::optional<PointArray>& out);
   OnlineMatcherSettings settings_;
   CubeRegistration registration_;
   std::deque<Keyframe> keyframes_;  // oldest first; back() is the reference's frame
@@ -295,6 +308,15 @@ class OnlineMatcher {
   std::optional<double> last_stamp_;
   std::deque<double> intervals_;  // [s] between consecutive scans, the last kIntervals
   static constexpr std::size_t kIntervals = 16;
+  /// The plane fit of an accepted result: RMS [m] and fraction of its points on planes.
+  struct PlaneFit {
+    double rms, fraction;
+  };
+  std::deque<PlaneFit> recent_fits_;  // of the last kRecentFits accepted results
+  static constexpr std::size_t kRecentFits = 9;
+  /// Why a sweep registered after rejected scans is still bent (DeskewSettings::
+  /// max_rms_ratio), or empty.
+  std::string bentSweep(const RegistrationResult& result) const;
   static constexpr double kMaxGateScale = 4.0;
   Eigen::Isometry3d last_pose_ = Eigen::Isometry3d::Identity();
   int consecutive_rejections_ = 0;
