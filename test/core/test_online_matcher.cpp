@@ -396,6 +396,22 @@ double rmsDistance(const PointArray& a, const PointArray& b) {
   return a.empty() ? 0.0 : std::sqrt(sum / double(a.size()));
 }
 
+/// Urban world 1 driven at 1 m/s and 20 deg/s (the yaw rate's sign flipping every sweep) with
+/// 2 s sweeps taken back to back by the tilting scanner.
+struct UrbanDrive {
+  const sim::Scene scene = sim::Scene::generate(sim::SceneType::Urban, 1);
+  const double d = 2.0;  ///< [s] sweep duration
+  const sim::DrivenPath path{scene, {1.0, 20.0, d, 1.0}, 30.0, 0.0, 0.0};
+  Eigen::Isometry3d mount = Eigen::Isometry3d::Identity();
+  UrbanDrive() { mount.linear() = sim::sensorToBodyRotation(); }
+  /// Sweep k, taken over (k - 1) d .. k d [s], lines cast from the true poses.
+  sim::TimedSweep sweep(int k, std::mt19937_64& rng) const {
+    return sim::scanDuringMotion(
+        scene, sim::ScannerModel{}, [&](double t) { return path.at(t) * mount; }, k * d, d,
+        k % 2 == 1, rng);
+  }
+};
+
 /// The error of each registered increment of a run driven at 1 m/s and 20 deg/s with 2 s
 /// sweeps, started standing still, odometry with the paper's "big" errors, every sweep placed
 /// by that odometry at its lines' times (as an assembler and tf give it). `shape_errors`: per
@@ -403,11 +419,11 @@ double rmsDistance(const PointArray& a, const PointArray& b) {
 /// de-skewed, else as placed) to the sweep placed with the true motion.
 std::vector<double> movingSweepErrors(bool deskew, std::vector<double>& angle_errors_deg,
                                       std::vector<double>& shape_errors) {
-  const sim::Scene scene = sim::Scene::generate(sim::SceneType::Urban, 1);
-  const double d = 2.0;
-  const sim::DrivenPath path(scene, {1.0, 20.0, d, 1.0}, 30.0, 0.0, 0.0);
-  Eigen::Isometry3d mount = Eigen::Isometry3d::Identity();
-  mount.linear() = sim::sensorToBodyRotation();
+  const UrbanDrive drive;
+  const sim::Scene& scene = drive.scene;
+  const double d = drive.d;
+  const sim::DrivenPath& path = drive.path;
+  const Eigen::Isometry3d& mount = drive.mount;
   std::mt19937_64 rng(11);
   OnlineMatcherSettings s;
   s.deskew.enabled = deskew;
@@ -419,8 +435,7 @@ std::vector<double> movingSweepErrors(bool deskew, std::vector<double>& angle_er
     const Eigen::Isometry3d next = path.at(k * d);
     const Eigen::Isometry3d increment = truth.inverse() * next;
     const Eigen::Isometry3d odom_increment = increment * sim::randomTransform(rng, 1.0, 8.0);
-    const sim::TimedSweep sweep = sim::scanDuringMotion(
-        scene, sim::ScannerModel{}, [&](double t) { return path.at(t) * mount; }, k * d, d, k % 2 == 1, rng);
+    const sim::TimedSweep sweep = drive.sweep(k, rng);
     const PointArray placed = sim::placeSweep(sweep, mount, odom_increment, d);
     odom = odom * odom_increment;
     const PointTimes times{sweep.time, true};
@@ -600,21 +615,17 @@ namespace {
 /// corrects it. `increment_error`: sweep 3's pose error against sweep 1 [m], [deg].
 OnlineStep sweepAfterARejection(bool check, double lost_odometry_error_deg,
                                 std::pair<double, double>& increment_error) {
-  const sim::Scene scene = sim::Scene::generate(sim::SceneType::Urban, 1);
-  const double d = 2.0;
-  const sim::DrivenPath path(scene, {1.0, 20.0, d, 1.0}, 30.0, 0.0, 0.0);
-  Eigen::Isometry3d mount = Eigen::Isometry3d::Identity();
-  mount.linear() = sim::sensorToBodyRotation();
+  const UrbanDrive drive;
+  const double d = drive.d;
+  const sim::DrivenPath& path = drive.path;
   std::mt19937_64 rng(5);
   OnlineMatcherSettings s;
   if (!check) s.deskew.max_rms_ratio = s.deskew.min_plane_fraction_ratio = 0.0;
   OnlineMatcher m(s);
-  m.process(sim::scanInBody(scene, sim::ScannerModel{}, path.at(0.0), rng), 0.0, path.at(0.0));
+  m.process(sim::scanInBody(drive.scene, sim::ScannerModel{}, path.at(0.0), rng), 0.0, path.at(0.0));
   const auto sweepAt = [&](int k, const Eigen::Isometry3d& placed_increment) {
-    const sim::TimedSweep sweep = sim::scanDuringMotion(
-        scene, sim::ScannerModel{}, [&](double t) { return path.at(t) * mount; }, k * d, d,
-        k % 2 == 1, rng);
-    return std::make_pair(sim::placeSweep(sweep, mount, placed_increment, d), sweep.time);
+    const sim::TimedSweep sweep = drive.sweep(k, rng);
+    return std::make_pair(sim::placeSweep(sweep, drive.mount, placed_increment, d), sweep.time);
   };
   const auto [first, first_tau] = sweepAt(1, path.at(0.0).inverse() * path.at(d));
   const PointTimes first_times{first_tau, true};
