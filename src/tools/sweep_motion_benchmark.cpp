@@ -333,7 +333,7 @@ int main(int argc, char** argv) {
                   csv << int(j != k - 1) << res.J << res.reference_cubes << res.points_used
                       << res.plane_rms << res.plane_correspondences << res.translation_weak_ratio
                       << res.starts_agreeing << step.correction.head<3>().norm()
-                      << rad2deg(step.correction.tail<3>().norm());
+                      << rad2deg(Eigen::AngleAxisd(poseToIsometry(step.correction).linear()).angle());
                   csv.endRow();
                   rows.push_back(row);
                 }

@@ -28,9 +28,10 @@ enum class GateReason : std::uint8_t {
   /// The step would put a NaN, infinite or non-rigid pose into the chain: refused, the chain
   /// keeps its last known pose (OnlineMatcher::process).
   NonFinite = 13,
-  /// A sweep after rejected scans whose de-skewed registration leaves a plane residual well
-  /// above the recent accepted ones': still bent by a motion nobody registered
-  /// (DeskewSettings::max_rms_ratio).
+  /// A sweep after rejected scans whose de-skewed registration fits the reference's planes
+  /// much worse than the recent accepted results (a higher plane RMS or fewer points on
+  /// planes): still bent by a motion nothing registered (DeskewSettings::max_rms_ratio,
+  /// min_plane_fraction_ratio).
   BentSweep = 14,
 };
 std::string toString(GateReason reason);

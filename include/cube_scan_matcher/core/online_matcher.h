@@ -59,7 +59,7 @@ struct DeskewSettings {
   /// registration's plane RMS exceeds max_rms_ratio times, or its fraction of points on
   /// planes (RegistrationResult::plane_correspondences / points_used) falls below
   /// min_plane_fraction_ratio times, the median of the last accepted results' (BENCHMARK.md,
-  /// "Sweeps taken while driving"). 0 = off; else max_rms_ratio in [1, 100],
+  /// "Sweeps taken while driving"). Each 0 = off; else max_rms_ratio in [1, 100],
   /// min_plane_fraction_ratio in (0, 1].
   double max_rms_ratio = 1.6;
   double min_plane_fraction_ratio = 0.9;
@@ -315,7 +315,7 @@ class OnlineMatcher {
   std::deque<PlaneFit> recent_fits_;  // of the last kRecentFits accepted results
   static constexpr std::size_t kRecentFits = 9;
   /// Why a sweep registered after rejected scans is still bent (DeskewSettings::
-  /// max_rms_ratio), or empty.
+  /// max_rms_ratio, min_plane_fraction_ratio), or empty when it is not.
   std::string bentSweep(const RegistrationResult& result) const;
   static constexpr double kMaxGateScale = 4.0;
   Eigen::Isometry3d last_pose_ = Eigen::Isometry3d::Identity();
