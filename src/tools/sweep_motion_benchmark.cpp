@@ -266,7 +266,8 @@ int main(int argc, char** argv) {
                   "scene,world,trial,speed_mps,yaw_rate_dps,duration_s,odometry,mode,k,accepted,"
                   "success,Es_m,Ea_deg,time_s,Es_reg_m,Ea_reg_deg,reason,after_rejection,J,l,"
                   "points_used,plane_rms_m,plane_correspondences,translation_weak_ratio,"
-                  "starts_agreeing,correction_m,correction_deg");
+                  "starts_agreeing,correction_m,correction_deg,aligns,searches,deskew_rounds,"
+                  "register_s,deskew_s,reference_s,coarse_s,refine_s,polish_s");
     const sim::ScannerModel model;
     std::vector<Row> rows;
     int trial = 0;
@@ -334,6 +335,12 @@ int main(int argc, char** argv) {
                       << res.plane_rms << res.plane_correspondences << res.translation_weak_ratio
                       << res.starts_agreeing << step.correction.head<3>().norm()
                       << rad2deg(Eigen::AngleAxisd(poseToIsometry(step.correction).linear()).angle());
+                  // Where the step's time went (OnlineWork): the rigid registration, the de-skew
+                  // rounds (sweep polish and registrations), the keyframe's grids; and inside
+                  // every align() call, its stages.
+                  const OnlineWork& w = step.work;
+                  csv << w.aligns << w.searches << w.deskew_rounds << w.register_s << w.deskew_s
+                      << w.reference_s << w.coarse_s << w.refine_s << w.polish_s;
                   csv.endRow();
                   rows.push_back(row);
                 }
