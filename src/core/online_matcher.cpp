@@ -291,16 +291,16 @@ std::string OnlineMatcher::bentSweep(const RegistrationResult& r) const {
     std::nth_element(v.begin(), v.begin() + std::ptrdiff_t(v.size() / 2), v.end());
     return v[v.size() / 2];
   };
+  const PlaneFit fit = PlaneFit::of(r), recent{median(&PlaneFit::rms), median(&PlaneFit::fraction)};
   const DeskewSettings& d = settings_.deskew;
   std::ostringstream os;
   os.precision(3);
-  const double fraction = double(r.plane_correspondences) / double(r.points_used);
-  if (d.max_rms_ratio > 0.0 && r.plane_rms > d.max_rms_ratio * median(&PlaneFit::rms)) {
-    os << "plane RMS " << 100.0 * r.plane_rms << " cm > " << d.max_rms_ratio << " x the recent "
-       << 100.0 * median(&PlaneFit::rms) << " cm";
-  } else if (fraction < d.min_plane_fraction_ratio * median(&PlaneFit::fraction)) {
-    os << "points on planes " << fraction << " < " << d.min_plane_fraction_ratio
-       << " x the recent " << median(&PlaneFit::fraction);
+  if (d.max_rms_ratio > 0.0 && fit.rms > d.max_rms_ratio * recent.rms) {
+    os << "plane RMS " << 100.0 * fit.rms << " cm > " << d.max_rms_ratio << " x the recent "
+       << 100.0 * recent.rms << " cm";
+  } else if (fit.fraction < d.min_plane_fraction_ratio * recent.fraction) {
+    os << "points on planes " << fit.fraction << " < " << d.min_plane_fraction_ratio
+       << " x the recent " << recent.fraction;
   } else {
     return {};
   }
@@ -357,8 +357,7 @@ OnlineStep OnlineMatcher::process(const PointArray& points, double stamp,
   }
   const bool refused = !placeScan(step, keyframe, predicted.pose);
   if (step.accepted && step.result.polished && step.result.points_used > 0) {
-    recent_fits_.push_back({step.result.plane_rms, double(step.result.plane_correspondences) /
-                                                       double(step.result.points_used)});
+    recent_fits_.push_back(PlaneFit::of(step.result));
     if (recent_fits_.size() > kRecentFits) recent_fits_.pop_front();
   }
   countRejections(step, keyframe);

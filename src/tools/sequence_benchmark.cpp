@@ -422,13 +422,10 @@ int main(int argc, char** argv) {
           r.option("--no-odometry-dense-points", matcher_settings.no_odometry_dense_points) ||
           r.optionWith("--no-odometry-grid",
                        [&](const std::string& v) {
-                         const std::size_t colon = v.find(':');
-                         if (colon == std::string::npos) {
-                           throw std::invalid_argument("--no-odometry-grid: '" + v + "' is not M:DEG");
-                         }
+                         const auto [m, deg] = splitPair("--no-odometry-grid", v, "M:DEG");
                          PlanarGridSettings& g = matcher_settings.no_odometry_grid;
-                         g.half_width_m = io::parseNumber("--no-odometry-grid", v.substr(0, colon));
-                         g.half_yaw = deg2rad(io::parseNumber("--no-odometry-grid", v.substr(colon + 1)));
+                         g.half_width_m = io::parseNumber("--no-odometry-grid", m);
+                         g.half_yaw = deg2rad(io::parseNumber("--no-odometry-grid", deg));
                        }) ||
           r.option("--reject-degenerate", gate.reject_degenerate) ||
           r.option("--require-polish", gate.require_polish) ||

@@ -238,4 +238,13 @@ std::vector<std::string> splitList(const std::string& s) {
   return out;
 }
 
+std::pair<std::string, std::string> splitPair(const std::string& option, const std::string& value,
+                                              const std::string& form) {
+  const std::size_t colon = value.find(':');
+  if (colon == std::string::npos) {
+    throw std::invalid_argument(option + ": '" + value + "' is not " + form);
+  }
+  return {value.substr(0, colon), value.substr(colon + 1)};
+}
+
 }  // namespace cube_scan_matcher::tools

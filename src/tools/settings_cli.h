@@ -2,6 +2,7 @@
 #pragma once
 
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "cube_scan_matcher/core/filters.h"
@@ -24,5 +25,10 @@ std::string machineReport();
 
 /// "a,b,,c" -> {"a", "b", "c"} (empty items dropped).
 std::vector<std::string> splitList(const std::string& s);
+
+/// "a:b" -> {"a", "b"} at the first colon; throws std::invalid_argument naming `option` and
+/// the expected `form` (e.g. "MODE:N") when there is none.
+std::pair<std::string, std::string> splitPair(const std::string& option, const std::string& value,
+                                              const std::string& form);
 
 }  // namespace cube_scan_matcher::tools

@@ -171,11 +171,8 @@ int main(int argc, char** argv) {
     auto motions_of = [&](const std::string& v) {
       motions.clear();
       for (const std::string& m : splitList(v)) {
-        const std::size_t colon = m.find(':');
-        if (colon == std::string::npos)
-          throw std::invalid_argument("--motions: expected speed:yaw-rate, got " + m);
-        motions.push_back({io::parseNumber("--motions", m.substr(0, colon)),
-                           io::parseNumber("--motions", m.substr(colon + 1))});
+        const auto [speed, yaw_rate] = splitPair("--motions", m, "speed:yaw-rate");
+        motions.push_back({io::parseNumber("--motions", speed), io::parseNumber("--motions", yaw_rate)});
       }
     };
     auto durations_of = [&](const std::string& v) {
@@ -196,25 +193,22 @@ int main(int argc, char** argv) {
                         io::parseNumber("--check", f[3]), io::parseNumber("--check", f[4])});
     };
     auto wrong_cap_of = [&](const std::string& v) {
-      const std::size_t colon = v.find(':');
-      if (colon == std::string::npos) throw std::invalid_argument("--max-accepted-wrong: MODE:N");
-      wrong_cap_mode = v.substr(0, colon);
-      wrong_cap = ArgReader::convert<int>("--max-accepted-wrong", v.substr(colon + 1));
+      std::string n;
+      std::tie(wrong_cap_mode, n) = splitPair("--max-accepted-wrong", v, "MODE:N");
+      wrong_cap = ArgReader::convert<int>("--max-accepted-wrong", n);
       if (wrong_cap < 0) throw std::invalid_argument("--max-accepted-wrong: N must be >= 0");
     };
     auto success_floor_of = [&](const std::string& v) {
-      const std::size_t colon = v.find(':');
-      if (colon == std::string::npos) throw std::invalid_argument("--min-success: MODE:F");
-      success_floor_mode = v.substr(0, colon);
-      success_floor = io::parseNumber("--min-success", v.substr(colon + 1));
+      std::string f;
+      std::tie(success_floor_mode, f) = splitPair("--min-success", v, "MODE:F");
+      success_floor = io::parseNumber("--min-success", f);
       if (!(success_floor >= 0.0 && success_floor <= 1.0))
         throw std::invalid_argument("--min-success: F must be in [0, 1]");
     };
     auto bent_of = [&](const std::string& v) {
-      const std::size_t colon = v.find(':');
-      if (colon == std::string::npos) throw std::invalid_argument("--bent-sweep: R:F");
-      settings.deskew.max_rms_ratio = io::parseNumber("--bent-sweep", v.substr(0, colon));
-      settings.deskew.min_plane_fraction_ratio = io::parseNumber("--bent-sweep", v.substr(colon + 1));
+      const auto [rms, fraction] = splitPair("--bent-sweep", v, "R:F");
+      settings.deskew.max_rms_ratio = io::parseNumber("--bent-sweep", rms);
+      settings.deskew.min_plane_fraction_ratio = io::parseNumber("--bent-sweep", fraction);
     };
     for (ArgReader r(argc, argv); r.more();) {
       if (r.help()) return usage(std::cout), 0;

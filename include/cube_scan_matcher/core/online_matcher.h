@@ -308,9 +308,12 @@ class OnlineMatcher {
   std::optional<double> last_stamp_;
   std::deque<double> intervals_;  // [s] between consecutive scans, the last kIntervals
   static constexpr std::size_t kIntervals = 16;
-  /// The plane fit of an accepted result: RMS [m] and fraction of its points on planes.
+  /// The plane fit of a polished result: RMS [m] and fraction of its points on planes.
   struct PlaneFit {
     double rms, fraction;
+    static PlaneFit of(const RegistrationResult& r) {
+      return {r.plane_rms, double(r.plane_correspondences) / double(r.points_used)};
+    }
   };
   std::deque<PlaneFit> recent_fits_;  // of the last kRecentFits accepted results
   static constexpr std::size_t kRecentFits = 9;
